@@ -1,0 +1,167 @@
+#include "neighbour/cell_linked_list.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "core/parallel.hpp"
+
+namespace cosph {
+
+template <int D>
+CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double cutoff,
+                                  const Domain<D>& domain)
+    : positions_(positions), domain_(domain), cell_size_(cutoff) {
+  if (!(cutoff > 0.0)) throw std::invalid_argument("cell-linked list: cut-off must be positive");
+  Vec<D> lo = Vec<D>::Constant(0.0), hi = Vec<D>::Constant(0.0);
+  if (!positions.empty()) {
+    lo = positions[0];
+    hi = positions[0];
+    for (const auto& x : positions) {
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+  }
+  // Sparse clouds in a large box would create mostly empty cells: widen the cells so that there
+  // are at most a few per particle (a wider cell is still correct, only less selective).
+  double volume = 1.0;
+  for (int a = 0; a < D; ++a)
+    volume *= std::max(domain.periodic[a] ? domain.length(a) : hi[a] - lo[a], cutoff);
+  const double max_cells = 4.0 * static_cast<double>(std::max<std::size_t>(positions.size(), 1));
+  if (volume / std::pow(cell_size_, D) > max_cells)
+    cell_size_ = std::max(cell_size_, std::pow(volume / max_cells, 1.0 / D));
+
+  for (int a = 0; a < D; ++a) {
+    if (domain.periodic[a]) {
+      origin_[a] = domain.lower[a];
+      const double L = domain.length(a);
+      cells_[a] = static_cast<int>(std::floor(L / cutoff));
+      if (cells_[a] < 3)
+        throw std::invalid_argument("periodic axis " + std::to_string(a) + " is " +
+                                    std::to_string(L) +
+                                    " long, shorter than three cut-off radii (" +
+                                    std::to_string(3 * cutoff) + ")");
+      // On a periodic axis the cells must tile the period exactly; they stay >= cut-off wide.
+      if (cells_[a] > 3 && L / cells_[a] < cell_size_)
+        cells_[a] = std::max(3, static_cast<int>(std::floor(L / cell_size_)));
+    } else {
+      origin_[a] = lo[a];
+      cells_[a] = std::max(1, static_cast<int>(std::floor((hi[a] - lo[a]) / cell_size_)) + 1);
+    }
+  }
+
+  std::size_t total = 1;
+  for (int a = 0; a < D; ++a) total *= static_cast<std::size_t>(cells_[a]);
+  const std::size_t n = positions.size();
+  std::vector<std::size_t> cell(n);
+  parallel_for_each_index(n, [&](std::size_t i) { cell[i] = linear(cell_of_position(positions[i])); });
+  // Counting sort: stable, so particles in a cell stay in index order (deterministic lists).
+  cell_start_.assign(total + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell[i] + 1];
+  for (std::size_t c = 0; c < total; ++c) cell_start_[c + 1] += cell_start_[c];
+  particles_.resize(n);
+  std::vector<std::size_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) particles_[fill[cell[i]]++] = static_cast<Index>(i);
+}
+
+template <int D>
+std::array<int, D> CellLinkedList<D>::cell_of_position(const Vec<D>& x) const {
+  std::array<int, D> c;
+  for (int a = 0; a < D; ++a) {
+    double width = cell_size_;
+    if (domain_.periodic[a]) width = domain_.length(a) / cells_[a];
+    double s = (x[a] - origin_[a]) / width;
+    if (domain_.periodic[a]) s -= cells_[a] * std::floor(s / cells_[a]);
+    c[a] = std::clamp(static_cast<int>(std::floor(s)), 0, cells_[a] - 1);
+  }
+  return c;
+}
+
+template <int D>
+std::size_t CellLinkedList<D>::linear(const std::array<int, D>& c) const {
+  std::size_t k = 0;
+  for (int a = D - 1; a >= 0; --a) k = k * static_cast<std::size_t>(cells_[a]) + c[a];
+  return k;
+}
+
+namespace {
+
+// Two passes (count, then fill) so that the lists are built in parallel without atomics and come
+// out in the same order whatever the number of threads.
+template <int D, typename ForEach>
+NeighbourList build_list(std::size_t n, const ForEach& for_each) {
+  NeighbourList list;
+  std::vector<std::size_t> count(n);
+  parallel_for_each_index(n, [&](std::size_t i) {
+    std::size_t c = 0;
+    for_each(i, [&](Index) { ++c; });
+    count[i] = c;
+  });
+  list.offset.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) list.offset[i + 1] = list.offset[i] + count[i];
+  list.index.resize(list.offset[n]);
+  parallel_for_each_index(n, [&](std::size_t i) {
+    std::size_t k = list.offset[i];
+    for_each(i, [&](Index j) { list.index[k++] = j; });
+  });
+  return list;
+}
+
+}  // namespace
+
+template <int D>
+NeighbourList build_inner_list(const std::vector<Vec<D>>& positions, double cutoff,
+                               const Domain<D>& domain) {
+  CellLinkedList<D> cells(positions, cutoff, domain);
+  return build_list<D>(positions.size(), [&](std::size_t i, const auto& emit) {
+    cells.for_each_neighbour(positions[i], cutoff, static_cast<Index>(i), emit);
+  });
+}
+
+template <int D>
+NeighbourList build_contact_list(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,
+                                 double cutoff, const Domain<D>& domain) {
+  CellLinkedList<D> cells(b, cutoff, domain);
+  constexpr Index none = static_cast<Index>(-1);
+  return build_list<D>(a.size(), [&](std::size_t i, const auto& emit) {
+    cells.for_each_neighbour(a[i], cutoff, none, emit);
+  });
+}
+
+template <int D>
+NeighbourList brute_force_list(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,
+                               double cutoff, const Domain<D>& domain, bool same_set) {
+  NeighbourList list;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t j = 0; j < b.size(); ++j) {
+      if (same_set && i == j) continue;
+      if (domain.displacement(a[i], b[j]).norm() < cutoff) list.index.push_back(static_cast<Index>(j));
+    }
+    list.offset.push_back(list.index.size());
+  }
+  return list;
+}
+
+template <int D>
+std::vector<Index> cell_sort_order(const std::vector<Vec<D>>& positions, double cell_size,
+                                   const Domain<D>& domain) {
+  return CellLinkedList<D>(positions, cell_size, domain).cell_order();
+}
+
+#define COSPH_INSTANTIATE(D)                                                                    \
+  template class CellLinkedList<D>;                                                             \
+  template NeighbourList build_inner_list<D>(const std::vector<Vec<D>>&, double,                \
+                                             const Domain<D>&);                                 \
+  template NeighbourList build_contact_list<D>(const std::vector<Vec<D>>&,                      \
+                                               const std::vector<Vec<D>>&, double,              \
+                                               const Domain<D>&);                               \
+  template NeighbourList brute_force_list<D>(const std::vector<Vec<D>>&,                        \
+                                             const std::vector<Vec<D>>&, double,                \
+                                             const Domain<D>&, bool);                           \
+  template std::vector<Index> cell_sort_order<D>(const std::vector<Vec<D>>&, double,            \
+                                                 const Domain<D>&);
+COSPH_INSTANTIATE(2)
+COSPH_INSTANTIATE(3)
+
+}  // namespace cosph

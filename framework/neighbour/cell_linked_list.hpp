@@ -1,0 +1,99 @@
+// Cell-linked list: particles binned into cubic cells at least one cut-off radius wide, so that
+// every neighbour of a particle lies in its own or an adjacent cell (3^D cells). Used to build
+// inner lists (one set with itself), contact lists (one set against another, the larger cut-off
+// governs) and the cell-order permutation that sorts particles for memory locality.
+#pragma once
+
+#include <vector>
+
+#include "core/types.hpp"
+#include "neighbour/domain.hpp"
+#include "neighbour/neighbour_list.hpp"
+
+namespace cosph {
+
+template <int D>
+class CellLinkedList {
+ public:
+  // Bins `positions`. On periodic axes the domain bounds are used (the axis must be at least
+  // three cut-offs long); on the others the cells span the particles' bounding box.
+  CellLinkedList(const std::vector<Vec<D>>& positions, double cutoff, const Domain<D>& domain);
+
+  // All particles of the binned set within `cutoff` of x (strictly closer), excluding `self`.
+  // Calls f(j) in deterministic order.
+  template <typename F>
+  void for_each_neighbour(const Vec<D>& x, double cutoff, Index self, const F& f) const;
+
+  // Particle indices in cell order: positions[order[k]] are sorted by cell.
+  std::vector<Index> cell_order() const { return particles_; }
+
+ private:
+  std::array<int, D> cell_of_position(const Vec<D>& x) const;
+  std::size_t linear(const std::array<int, D>& c) const;
+
+  const std::vector<Vec<D>>& positions_;
+  Domain<D> domain_;
+  Vec<D> origin_;
+  double cell_size_;
+  std::array<int, D> cells_{};
+  std::vector<std::size_t> cell_start_;  // CSR over cells
+  std::vector<Index> particles_;         // particle indices grouped by cell
+};
+
+// Neighbours of every particle of one set among the same set (self excluded).
+template <int D>
+NeighbourList build_inner_list(const std::vector<Vec<D>>& positions, double cutoff,
+                               const Domain<D>& domain);
+
+// Neighbours of every particle of set a among the particles of set b. The cut-off is the larger
+// of the two sets' support radii (the caller passes it).
+template <int D>
+NeighbourList build_contact_list(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,
+                                 double cutoff, const Domain<D>& domain);
+
+// Reference O(N^2) search used by the tests.
+template <int D>
+NeighbourList brute_force_list(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,
+                               double cutoff, const Domain<D>& domain, bool same_set);
+
+// Permutation that sorts particles by cell (new[i] = old[order[i]]), for ParticleSet::permute.
+template <int D>
+std::vector<Index> cell_sort_order(const std::vector<Vec<D>>& positions, double cell_size,
+                                   const Domain<D>& domain);
+
+template <int D>
+template <typename F>
+void CellLinkedList<D>::for_each_neighbour(const Vec<D>& x, double cutoff, Index self,
+                                           const F& f) const {
+  const double cutoff2 = cutoff * cutoff;
+  const auto c = cell_of_position(x);
+  std::array<int, D> lo, hi;
+  for (int a = 0; a < D; ++a) {
+    lo[a] = c[a] - 1;
+    hi[a] = c[a] + 1;
+    if (!domain_.periodic[a]) {
+      lo[a] = std::max(lo[a], 0);
+      hi[a] = std::min(hi[a], cells_[a] - 1);
+    }
+  }
+  std::array<int, D> k = lo;
+  while (true) {
+    std::array<int, D> w = k;
+    for (int a = 0; a < D; ++a)
+      if (domain_.periodic[a]) w[a] = (w[a] + cells_[a]) % cells_[a];
+    const std::size_t cell = linear(w);
+    for (std::size_t p = cell_start_[cell]; p < cell_start_[cell + 1]; ++p) {
+      const Index j = particles_[p];
+      if (j == self) continue;
+      if (domain_.displacement(x, positions_[j]).squaredNorm() < cutoff2) f(j);
+    }
+    int a = 0;
+    for (; a < D; ++a) {
+      if (++k[a] <= hi[a]) break;
+      k[a] = lo[a];
+    }
+    if (a == D) break;
+  }
+}
+
+}  // namespace cosph
