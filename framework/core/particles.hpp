@@ -4,6 +4,7 @@
 // through ports. There are no per-particle objects: each field is one contiguous array.
 #pragma once
 
+#include <deque>
 #include <span>
 #include <string>
 #include <variant>
@@ -82,7 +83,7 @@ class ParticleSet {
   std::string name_;
   std::size_t size_ = 0;
   std::vector<FieldInfo> infos_;
-  std::vector<Storage> data_;
+  std::deque<Storage> data_;  // deque: registering a field never moves the others
 };
 
 extern template class ParticleSet<2>;

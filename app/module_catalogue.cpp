@@ -1,0 +1,16 @@
+#include "module_catalogue.hpp"
+
+#include "diffusion/diffusion_module.hpp"
+
+namespace cosph {
+
+const ModuleRegistry& builtin_modules() {
+  static const ModuleRegistry registry = [] {
+    ModuleRegistry r;
+    r.add("diffusion", make_diffusion_module);
+    return r;
+  }();
+  return registry;
+}
+
+}  // namespace cosph

@@ -1,0 +1,189 @@
+#include "driver/probe_set.hpp"
+
+#include <filesystem>
+
+#include "core/error.hpp"
+#include "driver/scene_geometry.hpp"
+#include "io/csv_time_series.hpp"
+#include "io/probes.hpp"
+#include "io/reductions.hpp"
+
+namespace cosph {
+
+namespace {
+
+template <int D>
+const BodyView<D>* find_body(const BodyViews& views, const std::string& body) {
+  const auto& list = [&]() -> const std::vector<BodyView<D>>& {
+    if constexpr (D == 2)
+      return views.bodies2;
+    else
+      return views.bodies3;
+  }();
+  for (const auto& v : list)
+    if (body.empty() || v.particles->name() == body) return &v;
+  return nullptr;
+}
+
+}  // namespace
+
+struct ProbeSet::Probe {
+  std::string name;
+  double interval = 0.0;
+  std::vector<std::string> columns;
+  std::vector<double> last;
+  std::unique_ptr<CsvTimeSeries> csv;
+  virtual ~Probe() = default;
+  virtual std::vector<double> evaluate() const = 0;
+};
+
+namespace {
+
+template <int D>
+struct PointProbeEntry : ProbeSet::Probe {
+  const BodyView<D>* body;
+  PointProbe<D> probe;
+  PointProbeEntry(const BodyView<D>* b, PointProbe<D> p) : body(b), probe(std::move(p)) {}
+  std::vector<double> evaluate() const override {
+    return probe.sample(*body->particles, "volume", body->kernel, body->domain);
+  }
+};
+
+template <int D>
+struct ReductionEntry : ProbeSet::Probe {
+  const BodyView<D>* body;
+  proto::Reduction spec;
+  std::vector<double> evaluate() const override {
+    const auto& p = *body->particles;
+    const std::string& q = spec.quantity();
+    if (q == "kinetic_energy") return {total_kinetic_energy<D>(p)};
+    if (q == "extent") return {extent<D>(p, spec.axis())};
+    if (q == "integral") return {integral<D>(p, spec.field())};
+    if (q == "total") {
+      if (p.info(spec.field()).kind == FieldKind::Scalar) return {total_scalar<D>(p, spec.field())};
+      const Vec<D> v = total_vector<D>(p, spec.field());
+      return std::vector<double>(v.data(), v.data() + D);
+    }
+    const auto& f = p.scalar(spec.field());
+    double m = q == "minimum" ? INFINITY : -INFINITY;
+    for (double v : f) m = q == "minimum" ? std::min(m, v) : std::max(m, v);
+    return {m};
+  }
+};
+
+template <int D>
+std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const BodyView<D>* body,
+                                            const std::string& path) {
+  const ParticleSet<D>& particles = *body->particles;
+  auto check_field = [&](const std::string& field, const std::string& key) {
+    std::string base = field;
+    if (!particles.has(base)) {
+      const auto dot = field.rfind('.');
+      if (dot != std::string::npos) base = field.substr(0, dot);
+    }
+    if (!particles.has(base))
+      throw ConfigError(key, "body '" + particles.name() + "' has no field '" + field + "'");
+  };
+  switch (spec.kind_case()) {
+    case proto::ProbeSpec::kPoints:
+    case proto::ProbeSpec::kLine: {
+      std::vector<Vec<D>> points;
+      const bool line = spec.has_line();
+      const auto& fields = line ? spec.line().fields() : spec.points().fields();
+      if (line) {
+        const Vec<D> a = to_vec<D>(spec.line().from().coordinates());
+        const Vec<D> b = to_vec<D>(spec.line().to().coordinates());
+        const int n = spec.line().count();
+        for (int k = 0; k < n; ++k) points.push_back(a + (b - a) * (double(k) / (n - 1)));
+      } else {
+        for (const auto& p : spec.points().at()) points.push_back(to_vec<D>(p.coordinates()));
+      }
+      std::vector<std::string> names(fields.begin(), fields.end());
+      for (std::size_t k = 0; k < names.size(); ++k)
+        check_field(names[k], path + (line ? ".line" : ".points") + ".fields[" + std::to_string(k) + "]");
+      auto entry = std::make_unique<PointProbeEntry<D>>(body, PointProbe<D>(points, names));
+      entry->columns = entry->probe.columns();
+      return entry;
+    }
+    case proto::ProbeSpec::kReduce: {
+      auto entry = std::make_unique<ReductionEntry<D>>();
+      entry->body = body;
+      entry->spec = spec.reduce();
+      const std::string& q = spec.reduce().quantity();
+      if (q != "kinetic_energy" && q != "extent") {
+        if (spec.reduce().field().empty())
+          throw ConfigError(path + ".reduce", "'" + q + "' needs a field");
+        check_field(spec.reduce().field(), path + ".reduce.field");
+      }
+      if (q == "extent" && spec.reduce().axis() >= D)
+        throw ConfigError(path + ".reduce.axis", "axis must be below the dimension");
+      if (q == "total" && particles.info(spec.reduce().field()).kind == FieldKind::Vector) {
+        for (int a = 0; a < D; ++a) entry->columns.push_back(spec.reduce().field() + "." + "xyz"[a]);
+      } else {
+        entry->columns = {q == "extent" ? "extent_" + std::string(1, "xyz"[spec.reduce().axis()])
+                                        : q + (spec.reduce().field().empty() ? "" : "_" + spec.reduce().field())};
+      }
+      return entry;
+    }
+    case proto::ProbeSpec::KIND_NOT_SET:
+      break;
+  }
+  throw ConfigError(path, "a probe needs one of: points, line, reduce");
+}
+
+}  // namespace
+
+ProbeSet::ProbeSet(const proto::Scene& scene,
+                   const std::vector<std::pair<std::string, BodyViews>>& modules,
+                   const std::string& directory) {
+  for (int k = 0; k < scene.probes_size(); ++k) {
+    const auto& spec = scene.probes(k);
+    const std::string path = "probes[" + std::to_string(k) + "]";
+    const BodyViews* views = nullptr;
+    for (const auto& [name, v] : modules)
+      if (spec.module().empty() || spec.module() == name) {
+        views = &v;
+        break;
+      }
+    if (!views) throw ConfigError(path + ".module", "no module named '" + spec.module() + "'");
+    std::unique_ptr<Probe> probe;
+    if (scene.dimension() == 2) {
+      const auto* body = find_body<2>(*views, spec.body());
+      if (!body) throw ConfigError(path + ".body", "no body named '" + spec.body() + "'");
+      probe = make_probe<2>(spec, body, path);
+    } else {
+      const auto* body = find_body<3>(*views, spec.body());
+      if (!body) throw ConfigError(path + ".body", "no body named '" + spec.body() + "'");
+      probe = make_probe<3>(spec, body, path);
+    }
+    for (const auto& other : probes_)
+      if (other->name == spec.name()) throw ConfigError(path + ".name", "two probes named '" + spec.name() + "'");
+    probe->name = spec.name();
+    probe->interval = spec.interval();
+    if (!directory.empty())
+      probe->csv = std::make_unique<CsvTimeSeries>(
+          (std::filesystem::path(directory) / (spec.name() + ".csv")).string(), probe->columns);
+    probes_.push_back(std::move(probe));
+  }
+}
+
+ProbeSet::~ProbeSet() = default;
+
+std::size_t ProbeSet::size() const { return probes_.size(); }
+double ProbeSet::interval(std::size_t k) const { return probes_[k]->interval; }
+
+void ProbeSet::sample(std::size_t k, double time) {
+  Probe& p = *probes_[k];
+  p.last = p.evaluate();
+  if (p.csv) p.csv->append(time, p.last);
+}
+
+std::map<std::string, std::map<std::string, double>> ProbeSet::last_values() const {
+  std::map<std::string, std::map<std::string, double>> out;
+  for (const auto& p : probes_)
+    for (std::size_t c = 0; c < p->columns.size() && c < p->last.size(); ++c)
+      out[p->name][p->columns[c]] = p->last[c];
+  return out;
+}
+
+}  // namespace cosph

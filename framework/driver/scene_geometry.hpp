@@ -1,0 +1,36 @@
+// Builds framework objects (shapes, bodies, domain, kernel) from their scene messages. Errors
+// become ConfigErrors naming the scene key path, so the user sees the line they wrote.
+#pragma once
+
+#include <string>
+
+#include "geometry/particle_cloud.hpp"
+#include "geometry/shapes.hpp"
+#include "kernels/kernel.hpp"
+#include "neighbour/domain.hpp"
+#include "scene.pb.h"
+
+namespace cosph {
+
+template <int D>
+Vec<D> to_vec(const google::protobuf::RepeatedField<double>& values);
+
+template <int D>
+ShapePtr<D> build_shape(const proto::Shape& spec, const std::string& key_path);
+
+// Particles of a body: its shape filled on a lattice, or its CSV point cloud.
+template <int D>
+ParticleCloud<D> build_body(const proto::BodySpec& spec, const std::string& key_path,
+                            const std::string& scene_directory);
+
+template <int D>
+Domain<D> build_domain(const proto::Scene& scene);
+
+Kernel build_kernel(const proto::BodySpec& body, int dimension);
+
+// Throws ConfigError if any position lies outside the scene's domain (when one is given).
+template <int D>
+void check_inside_domain(const proto::Scene& scene, const ParticleCloud<D>& cloud,
+                         const std::string& key_path);
+
+}  // namespace cosph

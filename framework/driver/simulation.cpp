@@ -1,0 +1,410 @@
+#include "driver/simulation.hpp"
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "driver/probe_set.hpp"
+#include "io/checkpoint_file.hpp"
+#include "io/pvd_collection.hpp"
+#include "io/vtp_writer.hpp"
+
+namespace cosph {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Events on a fixed grid of simulated times k * interval, tracked by index so that a restarted
+// run meets exactly the same event times (and therefore takes exactly the same steps).
+struct Schedule {
+  double interval = 0.0;  // 0: never
+  unsigned long long next = 0;
+  bool active() const { return interval > 0.0; }
+  double time() const { return static_cast<double>(next) * interval; }
+};
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream s;
+  s << std::setprecision(17) << v;
+  return s.str();
+}
+
+std::string fingerprint(const proto::Scene& scene) {
+  std::string bytes = std::to_string(scene.dimension());
+  for (const auto& m : scene.modules()) bytes += m.SerializeAsString();
+  if (scene.has_domain()) bytes += scene.domain().SerializeAsString();
+  std::ostringstream s;
+  s << std::hex << fnv1a64(bytes);
+  return s.str();
+}
+
+}  // namespace
+
+std::string RunSummary::to_json() const {
+  std::ostringstream j;
+  j << "{\n";
+  j << "  \"scene\": \"" << json_escape(scene) << "\",\n";
+  j << "  \"dimension\": " << dimension << ",\n";
+  j << "  \"threads\": " << threads << ",\n";
+  j << "  \"start_time\": " << json_number(start_time) << ",\n";
+  j << "  \"end_time\": " << json_number(end_time) << ",\n";
+  j << "  \"steps\": " << steps << ",\n";
+  j << "  \"wall_seconds\": " << json_number(wall_seconds) << ",\n";
+  j << "  \"cpu_seconds\": " << json_number(cpu_seconds) << ",\n";
+  j << "  \"output_seconds\": " << json_number(output_seconds) << ",\n";
+  j << "  \"particles\": " << particles << ",\n";
+  j << "  \"particle_steps_per_second\": " << json_number(particle_steps_per_second) << ",\n";
+  j << "  \"output_directory\": \"" << json_escape(output_directory) << "\",\n";
+  j << "  \"modules\": [";
+  for (std::size_t k = 0; k < modules.size(); ++k) {
+    const auto& m = modules[k];
+    j << (k ? "," : "") << "\n    {\"name\": \"" << json_escape(m.name) << "\", \"type\": \"" << json_escape(m.type)
+      << "\", \"particles\": " << m.particles << ", \"advance_seconds\": " << json_number(m.advance_seconds)
+      << ", \"features\": [";
+    for (std::size_t f = 0; f < m.features.size(); ++f)
+      j << (f ? ", " : "") << "\"" << json_escape(m.features[f]) << "\"";
+    j << "]}";
+  }
+  j << "\n  ],\n  \"outputs\": [";
+  for (std::size_t k = 0; k < outputs.size(); ++k) j << (k ? ", " : "") << "\"" << json_escape(outputs[k]) << "\"";
+  j << "],\n  \"probes\": {";
+  bool first = true;
+  for (const auto& [name, columns] : probes) {
+    j << (first ? "" : ",") << "\n    \"" << json_escape(name) << "\": {";
+    bool first_column = true;
+    for (const auto& [column, value] : columns) {
+      j << (first_column ? "" : ", ") << "\"" << json_escape(column) << "\": " << json_number(value);
+      first_column = false;
+    }
+    j << "}";
+    first = false;
+  }
+  j << "\n  }\n}\n";
+  return j.str();
+}
+
+struct Simulation::Impl {
+  std::unique_ptr<tbb::global_control> threads_control;
+  int threads = 1;
+  std::string directory;  // empty: no files
+  std::vector<std::pair<std::string, BodyViews>> views;
+  std::unique_ptr<ProbeSet> probes;
+  std::vector<std::pair<std::unique_ptr<PvdCollection>, const void*>> pvds;
+  Schedule output, checkpoint;
+  std::vector<Schedule> probe_schedules;
+  unsigned long long output_index = 0;
+  double time = 0.0;
+  unsigned long long steps = 0;
+  double output_seconds = 0.0;
+  std::vector<double> advance_seconds;
+};
+
+Simulation::Simulation(LoadedScene scene, const ModuleRegistry& registry, RunOptions options)
+    : scene_(std::move(scene)), registry_(registry), options_(std::move(options)), impl_(std::make_unique<Impl>()) {}
+
+Simulation::~Simulation() = default;
+
+void Simulation::initialize() {
+  const proto::Scene& s = scene_.scene;
+  int threads = options_.threads > 0 ? options_.threads : s.run().threads();
+  if (threads <= 0) threads = tbb::info::default_concurrency();
+  impl_->threads = threads;
+  impl_->threads_control =
+      std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+
+  try {
+    if (s.modules_size() > 1) {
+      std::set<std::string> names;
+      for (int k = 0; k < s.modules_size(); ++k)
+        if (!names.insert(s.modules(k).name()).second)
+          throw ConfigError("modules[" + std::to_string(k) + "].name",
+                            "two modules named '" + s.modules(k).name() + "'");
+    }
+    for (int k = 0; k < s.modules_size(); ++k) {
+      const auto& spec = s.modules(k);
+      ModuleContext context{&s, "modules[" + std::to_string(k) + "]", scene_.source.directory()};
+      const std::string type = module_type(spec);
+      if (type.empty()) throw ConfigError(context.key_path, "a module needs its type, e.g. 'diffusion:'");
+      if (spec.where() != "local")
+        throw ConfigError(context.key_path + ".where",
+                          "only 'local' modules are available in this build (got '" + spec.where() + "')");
+      auto module = registry_.create(type, spec, context);
+      module->initialize();
+      modules_.push_back(std::move(module));
+    }
+    for (const auto& m : modules_) {
+      BodyViews v;
+      m->bodies(v);
+      impl_->views.emplace_back(m->info().name, v);
+    }
+    if (!options_.bench) {
+      impl_->directory = options_.output_directory.empty() ? s.output().directory() : options_.output_directory;
+      std::filesystem::create_directories(impl_->directory);
+    }
+    impl_->probes = std::make_unique<ProbeSet>(s, impl_->views, impl_->directory);
+  } catch (const SceneError&) {
+    throw;
+  } catch (const ConfigError& e) {
+    throw SceneError(e.key_path(), scene_.source.format(e));
+  }
+  impl_->advance_seconds.assign(modules_.size(), 0.0);
+  impl_->output.interval = s.output().interval();
+  impl_->checkpoint.interval = s.checkpoint().interval();
+  for (std::size_t k = 0; k < impl_->probes->size(); ++k)
+    impl_->probe_schedules.push_back({impl_->probes->interval(k), 0});
+}
+
+RunSummary Simulation::run() {
+  Impl& I = *impl_;
+  const proto::Scene& s = scene_.scene;
+  const double end = options_.end_time >= 0.0 ? options_.end_time : s.end_time();
+  const bool files = !I.directory.empty();
+  const bool vtp = files && s.output().vtp();
+  const std::string fp = fingerprint(s);
+
+  auto write_output = [&](double t) {
+    if (!vtp) return;
+    const auto start = Clock::now();
+    std::size_t body = 0;
+    auto write_body = [&](const auto& view) {
+      if (I.pvds.size() <= body) {
+        const std::string pvd = (std::filesystem::path(I.directory) / (view.particles->name() + ".pvd")).string();
+        I.pvds.emplace_back(std::make_unique<PvdCollection>(pvd), view.particles);
+      }
+      std::ostringstream file;
+      file << view.particles->name() << "_" << std::setw(6) << std::setfill('0') << I.output_index << ".vtp";
+      write_vtp((std::filesystem::path(I.directory) / file.str()).string(), *view.particles);
+      I.pvds[body].first->add(t, file.str());
+      ++body;
+    };
+    for (const auto& [name, v] : I.views) {
+      for (const auto& b : v.bodies2) write_body(b);
+      for (const auto& b : v.bodies3) write_body(b);
+    }
+    ++I.output_index;
+    I.output_seconds += seconds_since(start);
+  };
+  auto sample_probe = [&](std::size_t k, double t) {
+    const auto start = Clock::now();
+    I.probes->sample(k, t);
+    I.output_seconds += seconds_since(start);
+  };
+  auto save_checkpoint = [&](const std::string& file) {
+    proto::Checkpoint c;
+    c.set_format_version(kCheckpointFormatVersion);
+    c.set_scene_fingerprint(fp);
+    c.set_time(I.time);
+    c.set_step(I.steps);
+    c.set_next_output(I.output.next);
+    (*c.mutable_driver_scalars())["next_checkpoint"] = static_cast<double>(I.checkpoint.next);
+    (*c.mutable_driver_scalars())["output_index"] = static_cast<double>(I.output_index);
+    for (std::size_t k = 0; k < I.probe_schedules.size(); ++k)
+      (*c.mutable_driver_scalars())["probe_next_" + std::to_string(k)] = static_cast<double>(I.probe_schedules[k].next);
+    for (const auto& m : modules_) {
+      StateRecord state;
+      m->save(state);
+      auto* ms = c.add_modules();
+      ms->set_name(m->info().name);
+      ms->set_type(m->info().type);
+      for (const auto& [name, values] : state.arrays) {
+        auto* f = ms->add_arrays();
+        f->set_name(name);
+        f->mutable_values()->Add(values.begin(), values.end());
+      }
+      for (const auto& [name, v] : state.scalars) (*ms->mutable_scalars())[name] = v;
+      for (const auto& [name, v] : state.integers) (*ms->mutable_integers())[name] = v;
+    }
+    const auto start = Clock::now();
+    write_checkpoint((std::filesystem::path(I.directory) / file).string(), c);
+    I.output_seconds += seconds_since(start);
+  };
+
+  // Where to start: t = 0, or a checkpoint.
+  bool restarted = false;
+  if (!options_.restart_file.empty()) {
+    const proto::Checkpoint c = read_checkpoint(options_.restart_file);
+    if (c.scene_fingerprint() != fp)
+      throw RuntimeError(options_.restart_file + ": checkpoint was written for another scene "
+                         "(its modules, resolution or domain differ)");
+    if (static_cast<std::size_t>(c.modules_size()) != modules_.size())
+      throw RuntimeError(options_.restart_file + ": checkpoint has " + std::to_string(c.modules_size()) +
+                         " modules, the scene " + std::to_string(modules_.size()));
+    for (std::size_t k = 0; k < modules_.size(); ++k) {
+      const auto& ms = c.modules(static_cast<int>(k));
+      if (ms.name() != modules_[k]->info().name || ms.type() != modules_[k]->info().type)
+        throw RuntimeError(options_.restart_file + ": checkpoint module '" + ms.name() + "' (" + ms.type() +
+                           ") does not match the scene's '" + modules_[k]->info().name + "'");
+      StateRecord state;
+      for (const auto& f : ms.arrays()) state.arrays[f.name()].assign(f.values().begin(), f.values().end());
+      for (const auto& [name, v] : ms.scalars()) state.scalars[name] = v;
+      for (const auto& [name, v] : ms.integers()) state.integers[name] = v;
+      modules_[k]->load(state);
+    }
+    I.time = c.time();
+    I.steps = c.step();
+    I.output.next = c.next_output();
+    auto scalar = [&](const std::string& key) {
+      auto it = c.driver_scalars().find(key);
+      return it == c.driver_scalars().end() ? 0.0 : it->second;
+    };
+    I.checkpoint.next = static_cast<unsigned long long>(scalar("next_checkpoint"));
+    I.output_index = static_cast<unsigned long long>(scalar("output_index"));
+    for (std::size_t k = 0; k < I.probe_schedules.size(); ++k)
+      I.probe_schedules[k].next = static_cast<unsigned long long>(scalar("probe_next_" + std::to_string(k)));
+    restarted = true;
+  }
+
+  const double start_time = I.time;
+  const unsigned long long start_steps = I.steps;
+  const double tolerance = 1e-12 * std::max(1.0, end);
+  // Fires every event due at time t (events on the grid at or before t).
+  auto fire_due = [&](double t, bool final) {
+    bool output_written = false;
+    if (I.output.active()) {
+      while (I.output.time() <= t + tolerance) {
+        if (!output_written) write_output(t);
+        output_written = true;
+        ++I.output.next;
+      }
+    }
+    if (final && !output_written && I.output_index > 0) write_output(t);
+    for (std::size_t k = 0; k < I.probe_schedules.size(); ++k) {
+      // A probe without its own interval samples on the output grid; its index counts there.
+      Schedule& ps = I.probe_schedules[k];
+      const double interval = ps.active() ? ps.interval : I.output.interval;
+      bool sampled = false;
+      if (interval > 0.0) {
+        while (static_cast<double>(ps.next) * interval <= t + tolerance) {
+          if (!sampled) sample_probe(k, t);
+          sampled = true;
+          ++ps.next;
+        }
+      }
+      if (!sampled && (final || (interval == 0.0 && t == start_time))) sample_probe(k, t);
+    }
+    if (files && I.checkpoint.active()) {
+      bool saved = false;
+      while (I.checkpoint.time() <= t + tolerance) {
+        if (!saved && t > start_time) {
+          std::ostringstream name;
+          name << "checkpoint_" << std::setw(6) << std::setfill('0') << I.checkpoint.next << ".ckpt";
+          save_checkpoint(name.str());
+        }
+        saved = true;
+        ++I.checkpoint.next;
+      }
+    }
+  };
+
+  const auto wall_start = Clock::now();
+  const std::clock_t cpu_start = std::clock();
+  if (!restarted) {
+    if (!I.output.active()) write_output(I.time);
+    fire_due(I.time, false);
+  }
+
+  const bool tty = isatty(STDERR_FILENO);
+  const double progress_interval = tty ? 0.5 : s.run().progress_interval();
+  auto last_progress = Clock::now();
+  auto progress = [&](bool final) {
+    if (!options_.progress) return;
+    if (!final && seconds_since(last_progress) < progress_interval) return;
+    last_progress = Clock::now();
+    const double wall = seconds_since(wall_start);
+    const double done = (I.time - start_time) / std::max(end - start_time, 1e-300);
+    const double eta = done > 0 ? wall * (1.0 - done) / done : 0.0;
+    std::ostringstream line;
+    line << "t = " << std::setprecision(6) << I.time << " / " << end << "  steps " << I.steps << "  wall "
+         << std::fixed << std::setprecision(1) << wall << " s  ETA " << eta << " s";
+    if (tty)
+      std::cerr << "\r" << line.str() << "   " << (final ? "\n" : "") << std::flush;
+    else
+      std::cerr << line.str() << "\n";
+  };
+
+  while (I.time < end - tolerance) {
+    double target = end;
+    if (I.output.active()) target = std::min(target, I.output.time());
+    if (I.checkpoint.active() && files) target = std::min(target, I.checkpoint.time());
+    for (const auto& ps : I.probe_schedules)
+      if (ps.active()) target = std::min(target, static_cast<double>(ps.next) * ps.interval);
+    double dt = target - I.time;
+    for (const auto& m : modules_) dt = std::min(dt, m->max_dt());
+    if (!(dt > 0.0) || !std::isfinite(dt))
+      throw RuntimeError("time step is " + json_number(dt) + " at t = " + json_number(I.time));
+    const bool reaches_target = dt >= target - I.time;
+    for (std::size_t k = 0; k < modules_.size(); ++k) {
+      const auto start = Clock::now();
+      modules_[k]->advance(dt);
+      I.advance_seconds[k] += seconds_since(start);
+    }
+    I.time = reaches_target ? target : I.time + dt;
+    ++I.steps;
+    fire_due(I.time, false);
+    progress(false);
+  }
+  fire_due(I.time, true);
+  if (files && s.checkpoint().at_end()) save_checkpoint("checkpoint_final.ckpt");
+  progress(true);
+
+  RunSummary summary;
+  summary.scene = scene_.source.file();
+  summary.dimension = s.dimension();
+  summary.threads = I.threads;
+  summary.start_time = start_time;
+  summary.end_time = I.time;
+  summary.steps = I.steps - start_steps;
+  summary.wall_seconds = seconds_since(wall_start);
+  summary.cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  summary.output_seconds = I.output_seconds;
+  summary.output_directory = I.directory;
+  for (std::size_t k = 0; k < modules_.size(); ++k) {
+    const ModuleInfo info = modules_[k]->info();
+    summary.modules.push_back({info.name, info.type, modules_[k]->particle_count(), info.active_features,
+                               I.advance_seconds[k]});
+    summary.particles += modules_[k]->particle_count();
+  }
+  summary.particle_steps_per_second =
+      summary.wall_seconds > 0 ? double(summary.particles) * double(summary.steps) / summary.wall_seconds : 0.0;
+  if (vtp) summary.outputs.push_back("vtp");
+  for (const auto& p : s.probes()) summary.outputs.push_back("probe:" + p.name());
+  if (files && (I.checkpoint.active() || s.checkpoint().at_end())) summary.outputs.push_back("checkpoint");
+  summary.probes = I.probes->last_values();
+  if (files) {
+    std::ofstream out(std::filesystem::path(I.directory) / "summary.json");
+    out << summary.to_json();
+  }
+  return summary;
+}
+
+}  // namespace cosph
