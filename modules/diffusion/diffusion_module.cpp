@@ -10,7 +10,6 @@
 #include "driver/scene_geometry.hpp"
 #include "expression/expression.hpp"
 #include "geometry/regions.hpp"
-#include "kernels/kernel_correction.hpp"
 #include "neighbour/cell_linked_list.hpp"
 
 namespace cosph {
@@ -92,16 +91,12 @@ class DiffusionModule final : public Module {
     apply_fixed_values();
 
     neighbours_ = build_inner_list<D>(x, kernel_.support_radius(), domain_);
-    std::vector<Mat<D>> B;
-    if (spec_.kernel_correction()) {
-      try {
-        compute_correction_matrices<D>(x, V, neighbours_, kernel_, domain_, B);
-      } catch (const RuntimeError& e) {
-        throw RuntimeError("module '" + name_ + "': " + e.what());
-      }
-    }
     const std::vector<Mat<D>> tensors(x.size(), tensor);
-    weights_ = diffusion_pair_weights<D>(x, V, neighbours_, kernel_, domain_, tensors, B);
+    try {
+      weights_ = diffusion_pair_weights<D>(x, V, neighbours_, kernel_, domain_, tensors, spec_.kernel_correction());
+    } catch (const RuntimeError& e) {
+      throw RuntimeError("module '" + name_ + "': " + e.what());
+    }
 
     // Seed 001: dt = 0.5 h^2 / (d tr D). The explicit Euler step is also kept below the
     // Gershgorin bound 1 / max_i sum_j w_ij of the assembled operator, which guarantees

@@ -1,7 +1,11 @@
 #include "diffusion/diffusion_operator.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
 
 #include "core/parallel.hpp"
 
@@ -11,8 +15,30 @@ template <int D>
 double anisotropic_pair_factor(const Mat<D>& diffusion_inverse, double inverse_sqrt_det,
                                const Vec<D>& e) {
   const double q = e.dot(diffusion_inverse * e);
-  return inverse_sqrt_det * std::pow(q, -0.5 * (D + 2));
+  // q^(-(d+2)/2) without pow(): q^-2 in 2D, q^-2.5 in 3D.
+  if constexpr (D == 2)
+    return inverse_sqrt_det / (q * q);
+  else
+    return inverse_sqrt_det / (q * q * std::sqrt(q));
 }
+
+template <int D>
+Mat<D> diffusion_second_moment(std::size_t i, const std::vector<Vec<D>>& positions,
+                               const std::vector<double>& volumes, const NeighbourList& neighbours,
+                               const Kernel& kernel, const Domain<D>& domain, const Mat<D>& A) {
+  const Mat<D> A_inverse = A.inverse();
+  const double inverse_sqrt_det = 1.0 / std::sqrt(A.determinant());
+  Mat<D> S = Mat<D>::Zero();
+  for (Index j : neighbours.of(i)) {
+    const Vec<D> rij = domain.displacement(positions[i], positions[j]);
+    const double r = rij.norm();
+    const Vec<D> e = rij / r;
+    const double g = anisotropic_pair_factor<D>(A_inverse, inverse_sqrt_det, e);
+    S += volumes[j] * (-kernel.derivative(r) * r) * g * e * e.transpose();
+  }
+  return S;
+}
+
 
 template <int D>
 std::vector<double> diffusion_pair_weights(const std::vector<Vec<D>>& positions,
@@ -20,19 +46,44 @@ std::vector<double> diffusion_pair_weights(const std::vector<Vec<D>>& positions,
                                            const NeighbourList& neighbours, const Kernel& kernel,
                                            const Domain<D>& domain,
                                            const std::vector<Mat<D>>& diffusion_tensor,
-                                           const std::vector<Mat<D>>& B) {
+                                           bool corrected) {
+  const std::size_t n = positions.size();
+  std::vector<Mat<D>> A = diffusion_tensor;
+  if (corrected) {
+    // Near a free boundary the moment is deficient along the normal (half of it on a face, more
+    // at corners) and the calibration would inflate A without bound; there the missing pairs *are*
+    // the zero-flux condition. So A is kept within a factor kMaxCorrection of D, in D's own
+    // metric: interior particles are calibrated exactly, boundary ones partly.
+    constexpr double kMaxCorrection = 1.5;
+    parallel_for_each_index(n, [&](std::size_t i) {
+      const Mat<D>& target = diffusion_tensor[i];
+      const Eigen::SelfAdjointEigenSolver<Mat<D>> eigen(target);
+      const Mat<D> root = eigen.operatorSqrt(), inverse_root = eigen.operatorInverseSqrt();
+      const double scale = target.norm();
+      Mat<D> a = target;
+      for (int iteration = 0; iteration < 50; ++iteration) {
+        const Mat<D> S = diffusion_second_moment<D>(i, positions, volumes, neighbours, kernel, domain, a);
+        const Mat<D> residual = target - S;
+        if (residual.norm() < 1e-12 * scale || !(S.trace() > 0.0)) break;
+        a += (a.trace() / S.trace()) * residual;
+        // Clamp the eigenvalues of D^-1/2 A D^-1/2 to [1/k, k].
+        const Mat<D> m = inverse_root * (0.5 * (a + a.transpose())) * inverse_root;
+        const Eigen::SelfAdjointEigenSolver<Mat<D>> em(m);
+        const Vec<D> clamped = em.eigenvalues().cwiseMax(1.0 / kMaxCorrection).cwiseMin(kMaxCorrection);
+        a = root * (em.eigenvectors() * clamped.asDiagonal() * em.eigenvectors().transpose()) * root;
+      }
+      A[i] = a;
+    });
+  }
   std::vector<double> weights(neighbours.pair_count());
-  const bool corrected = !B.empty();
-  parallel_for_each_index(positions.size(), [&](std::size_t i) {
+  parallel_for_each_index(n, [&](std::size_t i) {
     for (std::size_t k = neighbours.offset[i]; k < neighbours.offset[i + 1]; ++k) {
       const Index j = neighbours.index[k];
       const Vec<D> rij = domain.displacement(positions[i], positions[j]);
       const double r = rij.norm();
-      const Vec<D> e = rij / r;
-      const Mat<D> Dij = 0.5 * (diffusion_tensor[i] + diffusion_tensor[j]);
-      const double g = anisotropic_pair_factor<D>(Dij.inverse(), 1.0 / std::sqrt(Dij.determinant()), e);
-      const double correction = corrected ? 0.5 * e.dot((B[i] + B[j]) * e) : 1.0;
-      weights[k] = 2.0 * volumes[j] * (-kernel.derivative(r) / r) * g * correction;
+      const Mat<D> Aij = 0.5 * (A[i] + A[j]);
+      const double g = anisotropic_pair_factor<D>(Aij.inverse(), 1.0 / std::sqrt(Aij.determinant()), rij / r);
+      weights[k] = 2.0 * volumes[j] * (-kernel.derivative(r) / r) * g;
     }
   });
   return weights;
@@ -54,7 +105,10 @@ void apply_diffusion(const NeighbourList& neighbours, const std::vector<double>&
   template double anisotropic_pair_factor<D>(const Mat<D>&, double, const Vec<D>&);          \
   template std::vector<double> diffusion_pair_weights<D>(                                     \
       const std::vector<Vec<D>>&, const std::vector<double>&, const NeighbourList&,           \
-      const Kernel&, const Domain<D>&, const std::vector<Mat<D>>&, const std::vector<Mat<D>>&);
+      const Kernel&, const Domain<D>&, const std::vector<Mat<D>>&, bool);                    \
+  template Mat<D> diffusion_second_moment<D>(std::size_t, const std::vector<Vec<D>>&,          \
+                                             const std::vector<double>&, const NeighbourList&, \
+                                             const Kernel&, const Domain<D>&, const Mat<D>&);
 COSPH_INSTANTIATE(2)
 COSPH_INSTANTIATE(3)
 

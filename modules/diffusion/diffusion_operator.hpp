@@ -9,10 +9,16 @@
 // covariance D), so the continuum operator is D : grad grad c with strictly positive weights —
 // unlike the Espanol-Revenga form, whose weights turn negative for strong anisotropy, and unlike
 // the 1/(e . D^-1 e) weight of Tran-Duc et al., which is exact only along D's principal axes.
-// Kernel correction (seed 001 section 4.2.1, seed 000 eqs. 16-17) multiplies each pair by
-// e . (B_i + B_j)/2 e: on a deficient or perturbed neighbourhood the discrete second moment is
-// B^-1 instead of I, and this factor restores it along the pair direction. The symmetric pair
-// average keeps V_i w_ij = V_j w_ji, so the total amount sum_i V_i c_i is conserved exactly.
+// Kernel correction. On a finite particle set the discrete second moment of the pair weights,
+//   S_i = 1/2 sum_j w_ij r_ij (x) r_ij,
+// differs from D: by a few percent on a lattice (only a few pair directions sample g), and by up
+// to half near free boundaries. Seed 001 corrects the first moment with the matrix B (eq. 35);
+// here the same idea is applied to the moment the Laplacian needs: each particle gets the tensor
+// A_i for which its weights, built with g_A instead of g_D, reproduce S_i = D_i exactly (a few
+// fixed-point iterations A += (D - S(A)) tr A / tr S, once, at start-up; particles do not move).
+// Near free boundaries the correction is bounded (see diffusion_operator.cpp).
+// Pairs use (A_i + A_j)/2, which keeps V_i w_ij = V_j w_ji and so conserves sum_i V_i c_i exactly;
+// in the interior of a regular lattice all A_i agree and the operator is exact for quadratic c.
 #pragma once
 
 #include <vector>
@@ -29,14 +35,21 @@ template <int D>
 double anisotropic_pair_factor(const Mat<D>& diffusion_inverse, double inverse_sqrt_det,
                                const Vec<D>& e);
 
-// Pair weights aligned with `neighbours` (CSR). `B` may be empty (no kernel correction).
+// Pair weights aligned with `neighbours` (CSR), from each particle's diffusion tensor; with
+// `corrected` the tensors are first calibrated as described above.
 template <int D>
 std::vector<double> diffusion_pair_weights(const std::vector<Vec<D>>& positions,
                                            const std::vector<double>& volumes,
                                            const NeighbourList& neighbours, const Kernel& kernel,
                                            const Domain<D>& domain,
                                            const std::vector<Mat<D>>& diffusion_tensor,
-                                           const std::vector<Mat<D>>& B);
+                                           bool corrected);
+
+// The discrete second moment S_i of particle i's weights built from the tensor A (see above).
+template <int D>
+Mat<D> diffusion_second_moment(std::size_t i, const std::vector<Vec<D>>& positions,
+                               const std::vector<double>& volumes, const NeighbourList& neighbours,
+                               const Kernel& kernel, const Domain<D>& domain, const Mat<D>& A);
 
 // rate_i = sum_j w_ij (c_j - c_i). Gather loop: each particle writes only its own rate.
 void apply_diffusion(const NeighbourList& neighbours, const std::vector<double>& weights,
