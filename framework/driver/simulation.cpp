@@ -287,49 +287,55 @@ RunSummary Simulation::run() {
   const double start_time = I.time;
   const unsigned long long start_steps = I.steps;
   const double tolerance = 1e-12 * std::max(1.0, end);
-  // Fires every event due at time t (events on the grid at or before t).
+  // Fires every event due at time t (events on the grid at or before t); the final call also
+  // writes the last state and probe values unless they were just written at this time.
+  double last_output_time = -INFINITY;
+  std::vector<double> last_probe_time(I.probe_schedules.size(), -INFINITY);
   auto fire_due = [&](double t, bool final) {
-    bool output_written = false;
-    if (I.output.active()) {
-      while (I.output.time() <= t + tolerance) {
-        if (!output_written) write_output(t);
-        output_written = true;
-        ++I.output.next;
-      }
+    bool output_due = false;
+    while (I.output.active() && I.output.time() <= t + tolerance) {
+      output_due = true;
+      ++I.output.next;
     }
-    if (final && !output_written && I.output_index > 0) write_output(t);
+    if (output_due || (final && last_output_time != t)) {
+      write_output(t);
+      last_output_time = t;
+    }
     for (std::size_t k = 0; k < I.probe_schedules.size(); ++k) {
       // A probe without its own interval samples on the output grid; its index counts there.
       Schedule& ps = I.probe_schedules[k];
       const double interval = ps.active() ? ps.interval : I.output.interval;
-      bool sampled = false;
-      if (interval > 0.0) {
-        while (static_cast<double>(ps.next) * interval <= t + tolerance) {
-          if (!sampled) sample_probe(k, t);
-          sampled = true;
-          ++ps.next;
-        }
+      bool due = false;
+      while (interval > 0.0 && static_cast<double>(ps.next) * interval <= t + tolerance) {
+        due = true;
+        ++ps.next;
       }
-      if (!sampled && (final || (interval == 0.0 && t == start_time))) sample_probe(k, t);
+      if (due || (last_probe_time[k] != t && (final || (interval == 0.0 && t == start_time)))) {
+        sample_probe(k, t);
+        last_probe_time[k] = t;
+      }
     }
-    if (files && I.checkpoint.active()) {
-      bool saved = false;
-      while (I.checkpoint.time() <= t + tolerance) {
-        if (!saved && t > start_time) {
-          std::ostringstream name;
-          name << "checkpoint_" << std::setw(6) << std::setfill('0') << I.checkpoint.next << ".ckpt";
-          save_checkpoint(name.str());
-        }
-        saved = true;
-        ++I.checkpoint.next;
-      }
+    // Checkpoints are saved after the schedules moved past t, so that a restart from one does not
+    // fire the same events again.
+    bool checkpoint_due = false;
+    while (files && I.checkpoint.active() && I.checkpoint.time() <= t + tolerance) {
+      checkpoint_due = true;
+      ++I.checkpoint.next;
+    }
+    if (checkpoint_due && t > start_time) {
+      std::ostringstream name;
+      name << "checkpoint_" << std::setw(6) << std::setfill('0') << I.checkpoint.next - 1 << ".ckpt";
+      save_checkpoint(name.str());
     }
   };
 
   const auto wall_start = Clock::now();
   const std::clock_t cpu_start = std::clock();
   if (!restarted) {
-    if (!I.output.active()) write_output(I.time);
+    if (!I.output.active()) {
+      write_output(I.time);
+      last_output_time = I.time;
+    }
     fire_due(I.time, false);
   }
 

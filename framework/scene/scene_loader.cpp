@@ -26,7 +26,7 @@ std::string SceneSource::directory() const {
 }
 
 void SceneSource::record(const std::string& key_path, int line, int column) {
-  lines_[key_path] = {line, column};
+  lines_.emplace(key_path, std::make_pair(line, column));  // the first mark (the key's) wins
 }
 
 void SceneSource::record_override(const std::string& key_path) { overridden_[key_path] = true; }
@@ -385,13 +385,14 @@ std::string apply_override(YAML::Node& root, const std::string& assignment, cons
     const Segment& seg = segments[s];
     if (!seg.key.empty()) {
       canonical += (canonical.empty() ? "" : ".") + seg.key;
-      if (!node.IsMap() && !node.IsNull())
+      if (node.IsDefined() && !node.IsMap() && !node.IsNull())
         throw SceneError(path, source.file() + ": --set " + path + ": '" + canonical +
                                    "' is inside a value that is not a mapping");
       if (last) {
         node[seg.key] = value;
       } else {
         YAML::Node next = node[seg.key];
+        if (!next.IsDefined() || next.IsNull()) next = YAML::Node(YAML::NodeType::Map);
         node.reset(next);
       }
       continue;

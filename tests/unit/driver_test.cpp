@@ -1,0 +1,197 @@
+// The driver: restart continues bit-identically, thread count does not change results, damaged
+// checkpoints are refused, and the command line maps errors to exit codes with clear messages.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cli.hpp"
+#include "core/error.hpp"
+#include "driver/simulation.hpp"
+#include "module_catalogue.hpp"
+
+namespace cosph {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* const kScene = R"yaml(name: driver_test
+dimension: 2
+end_time: 2.0
+domain: {lower: [0, 0], upper: [1, 1]}
+modules:
+  - name: blob
+    diffusion:
+      body:
+        spacing: 0.025
+        shape:
+          difference:
+            base: {box: {lower: [0, 0], upper: [1, 1]}}
+            subtract: {ellipsoid: {center: [0.7, 0.3], radius: 0.15}}
+      anisotropy: {direction: [1, 2], along: 2.0e-3, across: 2.0e-4}
+      initial: "exp(-((x - 0.4)^2 + (y - 0.6)^2) / 0.01)"
+      fixed_values:
+        - region: {name: left, shape: {box: {lower: [0, 0], upper: [0.05, 1]}}}
+          value: "0.5 * sin(t)"
+output: {interval: 0.5}
+checkpoint: {interval: 1.0}
+probes:
+  - name: point
+    points: {at: [[0.5, 0.5]], fields: [concentration]}
+  - name: total
+    reduce: {quantity: integral, field: concentration}
+)yaml";
+
+fs::path temp_dir(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("cosph_driver_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string write_scene(const fs::path& dir, const std::string& text) {
+  const fs::path file = dir / "scene.yaml";
+  std::ofstream(file) << text;
+  return file.string();
+}
+
+std::vector<double> final_field(const std::string& scene, RunOptions options) {
+  options.progress = false;
+  Simulation simulation(load_scene_file(scene), builtin_modules(), options);
+  simulation.initialize();
+  simulation.run();
+  BodyViews views;
+  simulation.module(0).bodies(views);
+  return views.bodies2.at(0).particles->scalar("concentration");
+}
+
+TEST(Driver, RestartFromCheckpointIsBitIdenticalToUninterruptedRun) {
+  const fs::path dir = temp_dir("restart");
+  const std::string scene = write_scene(dir, kScene);
+  RunOptions full;
+  full.output_directory = (dir / "full").string();
+  const std::vector<double> uninterrupted = final_field(scene, full);
+  const fs::path checkpoint = dir / "full" / "checkpoint_000001.ckpt";  // written at t = 1
+  ASSERT_TRUE(fs::exists(checkpoint));
+
+  RunOptions restart;
+  restart.output_directory = (dir / "restart").string();
+  restart.restart_file = checkpoint.string();
+  const std::vector<double> continued = final_field(scene, restart);
+  ASSERT_EQ(continued.size(), uninterrupted.size());
+  for (std::size_t i = 0; i < continued.size(); ++i) ASSERT_EQ(continued[i], uninterrupted[i]) << "particle " << i;
+  // The test has teeth: the state at t = 1 differs from the final one.
+  RunOptions half;
+  half.bench = true;
+  half.end_time = 1.0;
+  EXPECT_NE(final_field(scene, half), uninterrupted);
+}
+
+TEST(Driver, OneAndTwoThreadsGiveBitIdenticalResults) {
+  const fs::path dir = temp_dir("threads");
+  const std::string scene = write_scene(dir, kScene);
+  RunOptions one, two;
+  one.bench = two.bench = true;
+  one.threads = 1;
+  two.threads = 2;
+  EXPECT_EQ(final_field(scene, one), final_field(scene, two));
+}
+
+TEST(Driver, DamagedOrForeignCheckpointIsRefused) {
+  const fs::path dir = temp_dir("damaged");
+  const std::string scene = write_scene(dir, kScene);
+  RunOptions full;
+  full.output_directory = (dir / "out").string();
+  final_field(scene, full);
+  const fs::path good = dir / "out" / "checkpoint_final.ckpt";
+  std::string bytes;
+  {
+    std::ifstream in(good, std::ios::binary);
+    std::stringstream b;
+    b << in.rdbuf();
+    bytes = b.str();
+  }
+  auto refused = [&](const std::string& content, const std::string& scene_file, const std::string& expect) {
+    const fs::path bad = dir / "bad.ckpt";
+    std::ofstream(bad, std::ios::binary) << content;
+    RunOptions options;
+    options.bench = true;
+    options.restart_file = bad.string();
+    try {
+      final_field(scene_file, options);
+      ADD_FAILURE() << "checkpoint accepted, expected: " << expect;
+    } catch (const RuntimeError& e) {
+      EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+    }
+  };
+  std::string flipped = bytes;
+  flipped[flipped.size() / 2] ^= 0x20;
+  refused(flipped, scene, "");  // damaged payload: checksum or parse error
+  refused(bytes.substr(0, bytes.size() / 3), scene, "");
+  refused("hello", scene, "not a cosph checkpoint");
+  // A checkpoint of another resolution does not match the scene.
+  std::string other = kScene;
+  other.replace(other.find("spacing: 0.025"), 14, "spacing: 0.05");
+  refused(bytes, write_scene(temp_dir("damaged_other"), other), "another scene");
+}
+
+TEST(Driver, OutputFilesAreWritten) {
+  const fs::path dir = temp_dir("files");
+  const std::string scene = write_scene(dir, kScene);
+  RunOptions options;
+  options.output_directory = (dir / "out").string();
+  final_field(scene, options);
+  for (const char* f : {"blob.pvd", "blob_000000.vtp", "blob_000004.vtp", "point.csv", "total.csv", "summary.json"})
+    EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
+  std::ifstream csv(dir / "out" / "total.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("time,", 0), 0u) << header;
+  int rows = 0;
+  for (std::string line; std::getline(csv, line);) ++rows;
+  EXPECT_EQ(rows, 5);  // t = 0, 0.5, 1, 1.5, 2
+}
+
+int cli(const std::vector<std::string>& args, std::string* err_text = nullptr) {
+  std::ostringstream out, err;
+  const int code = run_cli(args, out, err);
+  if (err_text) *err_text = err.str();
+  return code;
+}
+
+TEST(CommandLine, ExitCodesAndMessages) {
+  const fs::path dir = temp_dir("cli");
+  const std::string scene = write_scene(dir, kScene);
+  EXPECT_EQ(cli({"help"}), 0);
+  EXPECT_EQ(cli({"check", scene}), 0);
+  std::string err;
+  EXPECT_EQ(cli({"frobnicate"}, &err), 2);
+  EXPECT_EQ(cli({"run", scene, "--threads", "zero"}, &err), 2);
+  EXPECT_NE(err.find("--threads"), std::string::npos);
+  // Bad scene value via --set: exit code 2 and the key path.
+  EXPECT_EQ(cli({"check", scene, "--set", "modules[0].diffusion.body.spacing=0"}, &err), 2);
+  EXPECT_NE(err.find("modules[0].diffusion.body.spacing: must be > 0"), std::string::npos) << err;
+  // A body outside the domain: exit code 2, named by its key path and line.
+  EXPECT_EQ(cli({"check", scene, "--set", "domain.upper=[0.5, 1]"}, &err), 2);
+  EXPECT_NE(err.find("modules[0].diffusion.body"), std::string::npos) << err;
+  EXPECT_NE(err.find("outside the domain"), std::string::npos) << err;
+  // Unreadable geometry: a missing point cloud file.
+  std::string csv_scene = kScene;
+  const auto at = csv_scene.find("        shape:");
+  csv_scene = csv_scene.substr(0, at) + "        points_csv: missing.csv\n" +
+              csv_scene.substr(csv_scene.find("      anisotropy"));
+  EXPECT_EQ(cli({"check", write_scene(temp_dir("cli_csv"), csv_scene)}, &err), 2);
+  EXPECT_NE(err.find("missing.csv"), std::string::npos) << err;
+  EXPECT_NE(err.find("points_csv"), std::string::npos) << err;
+  // A bad expression names its key.
+  EXPECT_EQ(cli({"check", scene, "--set", "modules[0].diffusion.initial=exp(-q)"}, &err), 2);
+  EXPECT_NE(err.find("modules[0].diffusion.initial"), std::string::npos) << err;
+  EXPECT_NE(err.find("unknown identifier 'q'"), std::string::npos) << err;
+  // Missing restart file: run-time error, exit code 1.
+  EXPECT_EQ(cli({"run", scene, "--bench", "--quiet", "--restart", (dir / "nope.ckpt").string()}, &err), 1);
+  EXPECT_NE(err.find("nope.ckpt: cannot open"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace cosph
