@@ -63,6 +63,8 @@ CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double c
   particles_.resize(n);
   std::vector<std::size_t> fill(cell_start_.begin(), cell_start_.end() - 1);
   for (std::size_t i = 0; i < n; ++i) particles_[fill[cell[i]]++] = static_cast<Index>(i);
+  sorted_positions_.resize(n);
+  parallel_for_each_index(n, [&](std::size_t p) { sorted_positions_[p] = positions[particles_[p]]; });
 }
 
 template <int D>

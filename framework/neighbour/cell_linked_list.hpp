@@ -38,6 +38,7 @@ class CellLinkedList {
   std::array<int, D> cells_{};
   std::vector<std::size_t> cell_start_;  // CSR over cells
   std::vector<Index> particles_;         // particle indices grouped by cell
+  std::vector<Vec<D>> sorted_positions_; // positions in the same order: candidates stream from memory
 };
 
 // Neighbours of every particle of one set among the same set (self excluded).
@@ -67,6 +68,7 @@ void CellLinkedList<D>::for_each_neighbour(const Vec<D>& x, double cutoff, Index
                                            const F& f) const {
   const double cutoff2 = cutoff * cutoff;
   const auto c = cell_of_position(x);
+  const bool periodic = domain_.any_periodic();
   std::array<int, D> lo, hi;
   for (int a = 0; a < D; ++a) {
     lo[a] = c[a] - 1;
@@ -82,10 +84,14 @@ void CellLinkedList<D>::for_each_neighbour(const Vec<D>& x, double cutoff, Index
     for (int a = 0; a < D; ++a)
       if (domain_.periodic[a]) w[a] = (w[a] + cells_[a]) % cells_[a];
     const std::size_t cell = linear(w);
-    for (std::size_t p = cell_start_[cell]; p < cell_start_[cell + 1]; ++p) {
-      const Index j = particles_[p];
-      if (j == self) continue;
-      if (domain_.displacement(x, positions_[j]).squaredNorm() < cutoff2) f(j);
+    const std::size_t end = cell_start_[cell + 1];
+    if (periodic) {
+      for (std::size_t p = cell_start_[cell]; p < end; ++p)
+        if (particles_[p] != self && domain_.displacement(x, sorted_positions_[p]).squaredNorm() < cutoff2)
+          f(particles_[p]);
+    } else {
+      for (std::size_t p = cell_start_[cell]; p < end; ++p)
+        if (particles_[p] != self && (x - sorted_positions_[p]).squaredNorm() < cutoff2) f(particles_[p]);
     }
     int a = 0;
     for (; a < D; ++a) {
