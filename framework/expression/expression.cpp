@@ -468,7 +468,7 @@ class Parser {
     next_ = i + length;
   }
 
-  // digits [. digits] [(e|E) [+|-] digits], or . digits [...]; i is at the first character.
+  // digits [. [digits]] [(e|E) [+|-] digits], or . digits [...]; `start` is its first character.
   void lex_number(std::size_t start) {
     std::size_t end = start;
     while (end < text_.size() && is_digit(text_[end])) ++end;
@@ -491,7 +491,7 @@ class Parser {
       while (end < text_.size() && is_digit(text_[end])) ++end;
     }
     // "1.2.3" or "1e5.5" is a typo, not two numbers that lack an operator between them.
-    if (end < text_.size() && (text_[end] == '.' || is_digit(text_[end]))) {
+    if (end < text_.size() && text_[end] == '.') {
       std::size_t stop = end;
       while (stop < text_.size() && (text_[stop] == '.' || is_digit(text_[stop]))) ++stop;
       malformed(stop, "unexpected '.'");
