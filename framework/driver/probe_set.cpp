@@ -98,6 +98,12 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
       } else {
         for (const auto& p : spec.points().at()) points.push_back(to_vec<D>(p.coordinates()));
       }
+      if (body->domain.upper != body->domain.lower)
+        for (std::size_t k = 0; k < points.size(); ++k)
+          for (int a = 0; a < D; ++a)
+            if (points[k][a] < body->domain.lower[a] || points[k][a] > body->domain.upper[a])
+              throw ConfigError(path + (line ? ".line" : ".points.at[" + std::to_string(k) + "]"),
+                                "probe point lies outside the domain");
       std::vector<std::string> names(fields.begin(), fields.end());
       for (std::size_t k = 0; k < names.size(); ++k)
         check_field(names[k], path + (line ? ".line" : ".points") + ".fields[" + std::to_string(k) + "]");

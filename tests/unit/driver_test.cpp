@@ -176,6 +176,14 @@ TEST(CommandLine, ExitCodesAndMessages) {
   EXPECT_EQ(cli({"check", scene, "--set", "domain.upper=[0.5, 1]"}, &err), 2);
   EXPECT_NE(err.find("modules[0].diffusion.body"), std::string::npos) << err;
   EXPECT_NE(err.find("outside the domain"), std::string::npos) << err;
+  // A probe outside the domain.
+  EXPECT_EQ(cli({"check", scene, "--set", "probes[0].points.at=[[1.5, 0.5]]"}, &err), 2);
+  EXPECT_NE(err.find("probes[0].points.at[0]: probe point lies outside the domain"), std::string::npos) << err;
+  // A fixed-value region that holds no particle.
+  EXPECT_EQ(cli({"check", scene, "--set",
+                 "modules[0].diffusion.fixed_values[0].region.shape={box: {lower: [2, 2], upper: [3, 3]}}"},
+                &err), 2);
+  EXPECT_NE(err.find("fixed_values[0].region: the region contains no particle"), std::string::npos) << err;
   // Unreadable geometry: a missing point cloud file.
   std::string csv_scene = kScene;
   const auto at = csv_scene.find("        shape:");
