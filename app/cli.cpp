@@ -100,7 +100,8 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       out << kUsage;
       return 0;
     }
-    if (a.command != "run" && a.command != "check") throw UsageError("unknown command '" + a.command + "'");
+    if (a.command != "run" && a.command != "check")
+      throw UsageError("unknown command '" + a.command + "'");
     if (a.scene.empty()) throw UsageError(a.command + " needs a scene file");
   } catch (const UsageError& e) {
     err << "cosph: " << e.what() << "\n\n" << kUsage;
@@ -115,15 +116,18 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       Simulation simulation(std::move(scene), builtin_modules(), options);
       simulation.initialize();
       std::size_t particles = 0;
-      for (std::size_t k = 0; k < simulation.module_count(); ++k) particles += simulation.module(k).particle_count();
-      out << a.scene << ": ok (" << simulation.module_count() << " module(s), " << particles << " particles)\n";
+      for (std::size_t k = 0; k < simulation.module_count(); ++k)
+        particles += simulation.module(k).particle_count();
+      out << a.scene << ": ok (" << simulation.module_count() << " module(s), " << particles
+          << " particles)\n";
       return 0;
     }
     Simulation simulation(std::move(scene), builtin_modules(), a.options);
     simulation.initialize();
     const RunSummary summary = simulation.run();
-    out << "steps " << summary.steps << "  particles " << summary.particles << "  wall " << summary.wall_seconds
-        << " s  particle-steps/s " << summary.particle_steps_per_second << "\n";
+    out << "steps " << summary.steps << "  particles " << summary.particles << "  wall "
+        << summary.wall_seconds << " s  particle-steps/s " << summary.particle_steps_per_second
+        << "\n";
     for (const auto& m : summary.modules) {
       out << "module " << m.name << " (" << m.type << "):";
       for (const auto& f : m.features) out << " [" << f << "]";

@@ -106,7 +106,8 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
                                 "probe point lies outside the domain");
       std::vector<std::string> names(fields.begin(), fields.end());
       for (std::size_t k = 0; k < names.size(); ++k)
-        check_field(names[k], path + (line ? ".line" : ".points") + ".fields[" + std::to_string(k) + "]");
+        check_field(names[k],
+                    path + (line ? ".line" : ".points") + ".fields[" + std::to_string(k) + "]");
       auto entry = std::make_unique<PointProbeEntry<D>>(body, PointProbe<D>(points, names));
       entry->columns = entry->probe.columns();
       return entry;
@@ -124,10 +125,12 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
       if (q == "extent" && spec.reduce().axis() >= D)
         throw ConfigError(path + ".reduce.axis", "axis must be below the dimension");
       if (q == "total" && particles.info(spec.reduce().field()).kind == FieldKind::Vector) {
-        for (int a = 0; a < D; ++a) entry->columns.push_back(spec.reduce().field() + "." + "xyz"[a]);
+        for (int a = 0; a < D; ++a)
+          entry->columns.push_back(spec.reduce().field() + "." + "xyz"[a]);
       } else {
-        entry->columns = {q == "extent" ? "extent_" + std::string(1, "xyz"[spec.reduce().axis()])
-                                        : q + (spec.reduce().field().empty() ? "" : "_" + spec.reduce().field())};
+        entry->columns = {
+            q == "extent" ? "extent_" + std::string(1, "xyz"[spec.reduce().axis()])
+                          : q + (spec.reduce().field().empty() ? "" : "_" + spec.reduce().field())};
       }
       return entry;
     }
@@ -163,7 +166,8 @@ ProbeSet::ProbeSet(const proto::Scene& scene,
       probe = make_probe<3>(spec, body, path);
     }
     for (const auto& other : probes_)
-      if (other->name == spec.name()) throw ConfigError(path + ".name", "two probes named '" + spec.name() + "'");
+      if (other->name == spec.name())
+        throw ConfigError(path + ".name", "two probes named '" + spec.name() + "'");
     probe->name = spec.name();
     probe->interval = spec.interval();
     if (!directory.empty())

@@ -16,8 +16,8 @@ namespace cosph {
 // What a factory gets besides the module's own spec.
 struct ModuleContext {
   const proto::Scene* scene = nullptr;
-  std::string key_path;        // e.g. "modules[0]" — prefix for ConfigError key paths
-  std::string scene_directory; // relative file paths in the scene are relative to it
+  std::string key_path;         // e.g. "modules[0]" — prefix for ConfigError key paths
+  std::string scene_directory;  // relative file paths in the scene are relative to it
 };
 
 using ModuleFactory =

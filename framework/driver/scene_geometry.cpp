@@ -33,16 +33,17 @@ ShapePtr<D> make_shape(const proto::Shape& spec, const std::string& path) {
     case proto::Shape::kTruncatedEllipsoidalShell:
       if constexpr (D == 3) {
         const auto& s = spec.truncated_ellipsoidal_shell();
-        return std::make_shared<TruncatedEllipsoidalShell>(s.inner_short_radius(), s.inner_long_radius(),
-                                                           s.outer_short_radius(), s.outer_long_radius(),
-                                                           s.truncation());
+        return std::make_shared<TruncatedEllipsoidalShell>(
+            s.inner_short_radius(), s.inner_long_radius(), s.outer_short_radius(),
+            s.outer_long_radius(), s.truncation());
       } else {
         throw ConfigError(path + ".truncated_ellipsoidal_shell", "is a 3D shape; the scene is 2D");
       }
     case proto::Shape::kPolygon:
       if constexpr (D == 2) {
         std::vector<Vec<2>> vertices;
-        for (const auto& p : spec.polygon().vertices()) vertices.push_back(to_vec<2>(p.coordinates()));
+        for (const auto& p : spec.polygon().vertices())
+          vertices.push_back(to_vec<2>(p.coordinates()));
         return std::make_shared<Polygon>(vertices);
       } else {
         throw ConfigError(path + ".polygon", "is a 2D shape; the scene is 3D");
@@ -61,8 +62,9 @@ ShapePtr<D> make_shape(const proto::Shape& spec, const std::string& path) {
     case proto::Shape::KIND_NOT_SET:
       break;
   }
-  throw ConfigError(path, "a shape needs one of: box, ellipsoid, truncated_ellipsoidal_shell, "
-                          "polygon, union, difference");
+  throw ConfigError(path,
+                    "a shape needs one of: box, ellipsoid, truncated_ellipsoidal_shell, "
+                    "polygon, union, difference");
 }
 
 }  // namespace
@@ -106,7 +108,8 @@ Domain<D> build_domain(const proto::Scene& scene) {
   domain.upper = to_vec<D>(scene.domain().upper());
   for (int a = 0; a < D; ++a) {
     if (!(domain.upper[a] > domain.lower[a]))
-      throw ConfigError("domain.upper[" + std::to_string(a) + "]", "must be greater than domain.lower");
+      throw ConfigError("domain.upper[" + std::to_string(a) + "]",
+                        "must be greater than domain.lower");
     domain.periodic[a] = a < scene.domain().periodic_size() && scene.domain().periodic(a);
   }
   return domain;
@@ -114,7 +117,8 @@ Domain<D> build_domain(const proto::Scene& scene) {
 
 Kernel build_kernel(const proto::BodySpec& body, int dimension) {
   const auto& k = body.kernel();
-  return Kernel(kernel_type_from_name(k.type()), dimension, k.smoothing_length_ratio() * body.spacing());
+  return Kernel(kernel_type_from_name(k.type()), dimension,
+                k.smoothing_length_ratio() * body.spacing());
 }
 
 template <int D>
@@ -133,13 +137,13 @@ void check_inside_domain(const proto::Scene& scene, const ParticleCloud<D>& clou
   }
 }
 
-#define COSPH_INSTANTIATE(D)                                                                   \
-  template Vec<D> to_vec<D>(const google::protobuf::RepeatedField<double>&);                  \
-  template ShapePtr<D> build_shape<D>(const proto::Shape&, const std::string&);               \
-  template ParticleCloud<D> build_body<D>(const proto::BodySpec&, const std::string&,          \
-                                          const std::string&);                                 \
-  template Domain<D> build_domain<D>(const proto::Scene&);                                     \
-  template void check_inside_domain<D>(const proto::Scene&, const ParticleCloud<D>&,           \
+#define COSPH_INSTANTIATE(D)                                                          \
+  template Vec<D> to_vec<D>(const google::protobuf::RepeatedField<double>&);          \
+  template ShapePtr<D> build_shape<D>(const proto::Shape&, const std::string&);       \
+  template ParticleCloud<D> build_body<D>(const proto::BodySpec&, const std::string&, \
+                                          const std::string&);                        \
+  template Domain<D> build_domain<D>(const proto::Scene&);                            \
+  template void check_inside_domain<D>(const proto::Scene&, const ParticleCloud<D>&,  \
                                        const std::string&);
 COSPH_INSTANTIATE(2)
 COSPH_INSTANTIATE(3)

@@ -9,9 +9,9 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <set>
 #include <iomanip>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -88,22 +88,24 @@ std::string RunSummary::to_json() const {
   j << "  \"modules\": [";
   for (std::size_t k = 0; k < modules.size(); ++k) {
     const auto& m = modules[k];
-    j << (k ? "," : "") << "\n    {\"name\": \"" << json_escape(m.name) << "\", \"type\": \"" << json_escape(m.type)
-      << "\", \"particles\": " << m.particles << ", \"advance_seconds\": " << json_number(m.advance_seconds)
-      << ", \"features\": [";
+    j << (k ? "," : "") << "\n    {\"name\": \"" << json_escape(m.name) << "\", \"type\": \""
+      << json_escape(m.type) << "\", \"particles\": " << m.particles
+      << ", \"advance_seconds\": " << json_number(m.advance_seconds) << ", \"features\": [";
     for (std::size_t f = 0; f < m.features.size(); ++f)
       j << (f ? ", " : "") << "\"" << json_escape(m.features[f]) << "\"";
     j << "]}";
   }
   j << "\n  ],\n  \"outputs\": [";
-  for (std::size_t k = 0; k < outputs.size(); ++k) j << (k ? ", " : "") << "\"" << json_escape(outputs[k]) << "\"";
+  for (std::size_t k = 0; k < outputs.size(); ++k)
+    j << (k ? ", " : "") << "\"" << json_escape(outputs[k]) << "\"";
   j << "],\n  \"probes\": {";
   bool first = true;
   for (const auto& [name, columns] : probes) {
     j << (first ? "" : ",") << "\n    \"" << json_escape(name) << "\": {";
     bool first_column = true;
     for (const auto& [column, value] : columns) {
-      j << (first_column ? "" : ", ") << "\"" << json_escape(column) << "\": " << json_number(value);
+      j << (first_column ? "" : ", ") << "\"" << json_escape(column)
+        << "\": " << json_number(value);
       first_column = false;
     }
     j << "}";
@@ -130,7 +132,10 @@ struct Simulation::Impl {
 };
 
 Simulation::Simulation(LoadedScene scene, const ModuleRegistry& registry, RunOptions options)
-    : scene_(std::move(scene)), registry_(registry), options_(std::move(options)), impl_(std::make_unique<Impl>()) {}
+    : scene_(std::move(scene)),
+      registry_(registry),
+      options_(std::move(options)),
+      impl_(std::make_unique<Impl>()) {}
 
 Simulation::~Simulation() = default;
 
@@ -154,10 +159,12 @@ void Simulation::initialize() {
       const auto& spec = s.modules(k);
       ModuleContext context{&s, "modules[" + std::to_string(k) + "]", scene_.source.directory()};
       const std::string type = module_type(spec);
-      if (type.empty()) throw ConfigError(context.key_path, "a module needs its type, e.g. 'diffusion:'");
+      if (type.empty())
+        throw ConfigError(context.key_path, "a module needs its type, e.g. 'diffusion:'");
       if (spec.where() != "local")
-        throw ConfigError(context.key_path + ".where",
-                          "only 'local' modules are available in this build (got '" + spec.where() + "')");
+        throw ConfigError(
+            context.key_path + ".where",
+            "only 'local' modules are available in this build (got '" + spec.where() + "')");
       auto module = registry_.create(type, spec, context);
       module->initialize();
       modules_.push_back(std::move(module));
@@ -168,7 +175,8 @@ void Simulation::initialize() {
       impl_->views.emplace_back(m->info().name, v);
     }
     if (!options_.bench) {
-      impl_->directory = options_.output_directory.empty() ? s.output().directory() : options_.output_directory;
+      impl_->directory =
+          options_.output_directory.empty() ? s.output().directory() : options_.output_directory;
       std::filesystem::create_directories(impl_->directory);
     }
     impl_->probes = std::make_unique<ProbeSet>(s, impl_->views, impl_->directory);
@@ -198,11 +206,13 @@ RunSummary Simulation::run() {
     std::size_t body = 0;
     auto write_body = [&](const auto& view) {
       if (I.pvds.size() <= body) {
-        const std::string pvd = (std::filesystem::path(I.directory) / (view.particles->name() + ".pvd")).string();
+        const std::string pvd =
+            (std::filesystem::path(I.directory) / (view.particles->name() + ".pvd")).string();
         I.pvds.emplace_back(std::make_unique<PvdCollection>(pvd), view.particles);
       }
       std::ostringstream file;
-      file << view.particles->name() << "_" << std::setw(6) << std::setfill('0') << I.output_index << ".vtp";
+      file << view.particles->name() << "_" << std::setw(6) << std::setfill('0') << I.output_index
+           << ".vtp";
       write_vtp((std::filesystem::path(I.directory) / file.str()).string(), *view.particles);
       I.pvds[body].first->add(t, file.str());
       ++body;
@@ -229,7 +239,8 @@ RunSummary Simulation::run() {
     (*c.mutable_driver_scalars())["next_checkpoint"] = static_cast<double>(I.checkpoint.next);
     (*c.mutable_driver_scalars())["output_index"] = static_cast<double>(I.output_index);
     for (std::size_t k = 0; k < I.probe_schedules.size(); ++k)
-      (*c.mutable_driver_scalars())["probe_next_" + std::to_string(k)] = static_cast<double>(I.probe_schedules[k].next);
+      (*c.mutable_driver_scalars())["probe_next_" + std::to_string(k)] =
+          static_cast<double>(I.probe_schedules[k].next);
     for (const auto& m : modules_) {
       StateRecord state;
       m->save(state);
@@ -254,18 +265,22 @@ RunSummary Simulation::run() {
   if (!options_.restart_file.empty()) {
     const proto::Checkpoint c = read_checkpoint(options_.restart_file);
     if (c.scene_fingerprint() != fp)
-      throw RuntimeError(options_.restart_file + ": checkpoint was written for another scene "
+      throw RuntimeError(options_.restart_file +
+                         ": checkpoint was written for another scene "
                          "(its modules, resolution or domain differ)");
     if (static_cast<std::size_t>(c.modules_size()) != modules_.size())
-      throw RuntimeError(options_.restart_file + ": checkpoint has " + std::to_string(c.modules_size()) +
-                         " modules, the scene " + std::to_string(modules_.size()));
+      throw RuntimeError(options_.restart_file + ": checkpoint has " +
+                         std::to_string(c.modules_size()) + " modules, the scene " +
+                         std::to_string(modules_.size()));
     for (std::size_t k = 0; k < modules_.size(); ++k) {
       const auto& ms = c.modules(static_cast<int>(k));
       if (ms.name() != modules_[k]->info().name || ms.type() != modules_[k]->info().type)
-        throw RuntimeError(options_.restart_file + ": checkpoint module '" + ms.name() + "' (" + ms.type() +
-                           ") does not match the scene's '" + modules_[k]->info().name + "'");
+        throw RuntimeError(options_.restart_file + ": checkpoint module '" + ms.name() + "' (" +
+                           ms.type() + ") does not match the scene's '" + modules_[k]->info().name +
+                           "'");
       StateRecord state;
-      for (const auto& f : ms.arrays()) state.arrays[f.name()].assign(f.values().begin(), f.values().end());
+      for (const auto& f : ms.arrays())
+        state.arrays[f.name()].assign(f.values().begin(), f.values().end());
       for (const auto& [name, v] : ms.scalars()) state.scalars[name] = v;
       for (const auto& [name, v] : ms.integers()) state.integers[name] = v;
       modules_[k]->load(state);
@@ -280,7 +295,8 @@ RunSummary Simulation::run() {
     I.checkpoint.next = static_cast<unsigned long long>(scalar("next_checkpoint"));
     I.output_index = static_cast<unsigned long long>(scalar("output_index"));
     for (std::size_t k = 0; k < I.probe_schedules.size(); ++k)
-      I.probe_schedules[k].next = static_cast<unsigned long long>(scalar("probe_next_" + std::to_string(k)));
+      I.probe_schedules[k].next =
+          static_cast<unsigned long long>(scalar("probe_next_" + std::to_string(k)));
     restarted = true;
   }
 
@@ -324,7 +340,8 @@ RunSummary Simulation::run() {
     }
     if (checkpoint_due && t > start_time) {
       std::ostringstream name;
-      name << "checkpoint_" << std::setw(6) << std::setfill('0') << I.checkpoint.next - 1 << ".ckpt";
+      name << "checkpoint_" << std::setw(6) << std::setfill('0') << I.checkpoint.next - 1
+           << ".ckpt";
       save_checkpoint(name.str());
     }
   };
@@ -350,8 +367,8 @@ RunSummary Simulation::run() {
     const double done = (I.time - start_time) / std::max(end - start_time, 1e-300);
     const double eta = done > 0 ? wall * (1.0 - done) / done : 0.0;
     std::ostringstream line;
-    line << "t = " << std::setprecision(6) << I.time << " / " << end << "  steps " << I.steps << "  wall "
-         << std::fixed << std::setprecision(1) << wall << " s  ETA " << eta << " s";
+    line << "t = " << std::setprecision(6) << I.time << " / " << end << "  steps " << I.steps
+         << "  wall " << std::fixed << std::setprecision(1) << wall << " s  ETA " << eta << " s";
     if (tty)
       std::cerr << "\r" << line.str() << "   " << (final ? "\n" : "") << std::flush;
     else
@@ -396,15 +413,18 @@ RunSummary Simulation::run() {
   summary.output_directory = I.directory;
   for (std::size_t k = 0; k < modules_.size(); ++k) {
     const ModuleInfo info = modules_[k]->info();
-    summary.modules.push_back({info.name, info.type, modules_[k]->particle_count(), info.active_features,
-                               I.advance_seconds[k]});
+    summary.modules.push_back({info.name, info.type, modules_[k]->particle_count(),
+                               info.active_features, I.advance_seconds[k]});
     summary.particles += modules_[k]->particle_count();
   }
   summary.particle_steps_per_second =
-      summary.wall_seconds > 0 ? double(summary.particles) * double(summary.steps) / summary.wall_seconds : 0.0;
+      summary.wall_seconds > 0
+          ? double(summary.particles) * double(summary.steps) / summary.wall_seconds
+          : 0.0;
   if (vtp) summary.outputs.push_back("vtp");
   for (const auto& p : s.probes()) summary.outputs.push_back("probe:" + p.name());
-  if (files && (I.checkpoint.active() || s.checkpoint().at_end())) summary.outputs.push_back("checkpoint");
+  if (files && (I.checkpoint.active() || s.checkpoint().at_end()))
+    summary.outputs.push_back("checkpoint");
   summary.probes = I.probes->last_values();
   if (files) {
     std::ofstream out(std::filesystem::path(I.directory) / "summary.json");

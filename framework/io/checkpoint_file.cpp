@@ -25,7 +25,8 @@ void write_checkpoint(const std::string& path, const proto::Checkpoint& checkpoi
   proto::CheckpointFile file;
   file.set_magic(kMagic);
   std::string payload;
-  if (!checkpoint.SerializeToString(&payload)) throw RuntimeError(path + ": cannot serialise checkpoint");
+  if (!checkpoint.SerializeToString(&payload))
+    throw RuntimeError(path + ": cannot serialise checkpoint");
   file.set_checksum(fnv1a64(payload));
   file.set_payload(std::move(payload));
   write_file_atomically(path, [&](std::ostream& out) {
@@ -47,7 +48,8 @@ proto::Checkpoint read_checkpoint(const std::string& path) {
   if (!checkpoint.ParseFromString(file.payload()))
     throw RuntimeError(path + ": checkpoint payload cannot be parsed");
   if (checkpoint.format_version() != kCheckpointFormatVersion)
-    throw RuntimeError(path + ": checkpoint format version " + std::to_string(checkpoint.format_version()) +
+    throw RuntimeError(path + ": checkpoint format version " +
+                       std::to_string(checkpoint.format_version()) +
                        " is not supported (this build reads version " +
                        std::to_string(kCheckpointFormatVersion) + ")");
   return checkpoint;

@@ -1,6 +1,7 @@
-// Checkpoint files: the complete state of a run as a binary protobuf message (proto/checkpoint.proto)
-// wrapped with a magic string and an FNV-1a checksum of the payload, written atomically (temp
-// file + rename). Reading refuses a damaged, truncated or foreign file with a clear error.
+// Checkpoint files: the complete state of a run as a binary protobuf message
+// (proto/checkpoint.proto) wrapped with a magic string and an FNV-1a checksum of the payload,
+// written atomically (temp file + rename). Reading refuses a damaged, truncated or foreign file
+// with a clear error.
 #pragma once
 
 #include <string>

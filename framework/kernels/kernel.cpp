@@ -27,7 +27,8 @@ std::string kernel_name(KernelType type) {
 
 Kernel::Kernel(KernelType type, int dimension, double smoothing_length)
     : type_(type), dimension_(dimension), h_(smoothing_length), inv_h_(1.0 / smoothing_length) {
-  if (dimension != 2 && dimension != 3) throw std::invalid_argument("kernel dimension must be 2 or 3");
+  if (dimension != 2 && dimension != 3)
+    throw std::invalid_argument("kernel dimension must be 2 or 3");
   if (!(smoothing_length > 0.0)) throw std::invalid_argument("smoothing length must be positive");
   const double pi = std::numbers::pi;
   // Normalisation constants: the integral of the dimensionless profile over the support, in

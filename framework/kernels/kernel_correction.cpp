@@ -63,14 +63,13 @@ void corrected_gradient(const std::vector<Vec<D>>& positions, const std::vector<
   });
 }
 
-#define COSPH_INSTANTIATE(D)                                                                   \
-  template void compute_correction_matrices<D>(const std::vector<Vec<D>>&,                    \
-                                               const std::vector<double>&,                     \
-                                               const NeighbourList&, const Kernel&,            \
-                                               const Domain<D>&, std::vector<Mat<D>>&);        \
-  template void corrected_gradient<D>(const std::vector<Vec<D>>&, const std::vector<double>&, \
-                                      const NeighbourList&, const Kernel&, const Domain<D>&,   \
-                                      const std::vector<Mat<D>>&, const std::vector<double>&,  \
+#define COSPH_INSTANTIATE(D)                                                                       \
+  template void compute_correction_matrices<D>(                                                    \
+      const std::vector<Vec<D>>&, const std::vector<double>&, const NeighbourList&, const Kernel&, \
+      const Domain<D>&, std::vector<Mat<D>>&);                                                     \
+  template void corrected_gradient<D>(const std::vector<Vec<D>>&, const std::vector<double>&,      \
+                                      const NeighbourList&, const Kernel&, const Domain<D>&,       \
+                                      const std::vector<Mat<D>>&, const std::vector<double>&,      \
                                       std::vector<Vec<D>>&);
 COSPH_INSTANTIATE(2)
 COSPH_INSTANTIATE(3)

@@ -38,10 +38,9 @@ CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double c
       const double L = domain.length(a);
       cells_[a] = static_cast<int>(std::floor(L / cutoff));
       if (cells_[a] < 3)
-        throw std::invalid_argument("periodic axis " + std::to_string(a) + " is " +
-                                    std::to_string(L) +
-                                    " long, shorter than three cut-off radii (" +
-                                    std::to_string(3 * cutoff) + ")");
+        throw std::invalid_argument(
+            "periodic axis " + std::to_string(a) + " is " + std::to_string(L) +
+            " long, shorter than three cut-off radii (" + std::to_string(3 * cutoff) + ")");
       // On a periodic axis the cells must tile the period exactly; they stay >= cut-off wide.
       if (cells_[a] > 3 && L / cells_[a] < cell_size_)
         cells_[a] = std::max(3, static_cast<int>(std::floor(L / cell_size_)));
@@ -55,7 +54,8 @@ CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double c
   for (int a = 0; a < D; ++a) total *= static_cast<std::size_t>(cells_[a]);
   const std::size_t n = positions.size();
   std::vector<std::size_t> cell(n);
-  parallel_for_each_index(n, [&](std::size_t i) { cell[i] = linear(cell_of_position(positions[i])); });
+  parallel_for_each_index(n,
+                          [&](std::size_t i) { cell[i] = linear(cell_of_position(positions[i])); });
   // Counting sort: stable, so particles in a cell stay in index order (deterministic lists).
   cell_start_.assign(total + 1, 0);
   for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell[i] + 1];
@@ -64,7 +64,8 @@ CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double c
   std::vector<std::size_t> fill(cell_start_.begin(), cell_start_.end() - 1);
   for (std::size_t i = 0; i < n; ++i) particles_[fill[cell[i]]++] = static_cast<Index>(i);
   sorted_positions_.resize(n);
-  parallel_for_each_index(n, [&](std::size_t p) { sorted_positions_[p] = positions[particles_[p]]; });
+  parallel_for_each_index(n,
+                          [&](std::size_t p) { sorted_positions_[p] = positions[particles_[p]]; });
 }
 
 template <int D>
@@ -138,7 +139,8 @@ NeighbourList brute_force_list(const std::vector<Vec<D>>& a, const std::vector<V
   for (std::size_t i = 0; i < a.size(); ++i) {
     for (std::size_t j = 0; j < b.size(); ++j) {
       if (same_set && i == j) continue;
-      if (domain.displacement(a[i], b[j]).norm() < cutoff) list.index.push_back(static_cast<Index>(j));
+      if (domain.displacement(a[i], b[j]).norm() < cutoff)
+        list.index.push_back(static_cast<Index>(j));
     }
     list.offset.push_back(list.index.size());
   }
@@ -151,17 +153,15 @@ std::vector<Index> cell_sort_order(const std::vector<Vec<D>>& positions, double 
   return CellLinkedList<D>(positions, cell_size, domain).cell_order();
 }
 
-#define COSPH_INSTANTIATE(D)                                                                    \
-  template class CellLinkedList<D>;                                                             \
-  template NeighbourList build_inner_list<D>(const std::vector<Vec<D>>&, double,                \
-                                             const Domain<D>&);                                 \
-  template NeighbourList build_contact_list<D>(const std::vector<Vec<D>>&,                      \
-                                               const std::vector<Vec<D>>&, double,              \
-                                               const Domain<D>&);                               \
-  template NeighbourList brute_force_list<D>(const std::vector<Vec<D>>&,                        \
-                                             const std::vector<Vec<D>>&, double,                \
-                                             const Domain<D>&, bool);                           \
-  template std::vector<Index> cell_sort_order<D>(const std::vector<Vec<D>>&, double,            \
+#define COSPH_INSTANTIATE(D)                                                                   \
+  template class CellLinkedList<D>;                                                            \
+  template NeighbourList build_inner_list<D>(const std::vector<Vec<D>>&, double,               \
+                                             const Domain<D>&);                                \
+  template NeighbourList build_contact_list<D>(                                                \
+      const std::vector<Vec<D>>&, const std::vector<Vec<D>>&, double, const Domain<D>&);       \
+  template NeighbourList brute_force_list<D>(                                                  \
+      const std::vector<Vec<D>>&, const std::vector<Vec<D>>&, double, const Domain<D>&, bool); \
+  template std::vector<Index> cell_sort_order<D>(const std::vector<Vec<D>>&, double,           \
                                                  const Domain<D>&);
 COSPH_INSTANTIATE(2)
 COSPH_INSTANTIATE(3)

@@ -38,7 +38,8 @@ class CellLinkedList {
   std::array<int, D> cells_{};
   std::vector<std::size_t> cell_start_;  // CSR over cells
   std::vector<Index> particles_;         // particle indices grouped by cell
-  std::vector<Vec<D>> sorted_positions_; // positions in the same order: candidates stream from memory
+  std::vector<Vec<D>>
+      sorted_positions_;  // positions in the same order: candidates stream from memory
 };
 
 // Neighbours of every particle of one set among the same set (self excluded).
@@ -87,11 +88,13 @@ void CellLinkedList<D>::for_each_neighbour(const Vec<D>& x, double cutoff, Index
     const std::size_t end = cell_start_[cell + 1];
     if (periodic) {
       for (std::size_t p = cell_start_[cell]; p < end; ++p)
-        if (particles_[p] != self && domain_.displacement(x, sorted_positions_[p]).squaredNorm() < cutoff2)
+        if (particles_[p] != self &&
+            domain_.displacement(x, sorted_positions_[p]).squaredNorm() < cutoff2)
           f(particles_[p]);
     } else {
       for (std::size_t p = cell_start_[cell]; p < end; ++p)
-        if (particles_[p] != self && (x - sorted_positions_[p]).squaredNorm() < cutoff2) f(particles_[p]);
+        if (particles_[p] != self && (x - sorted_positions_[p]).squaredNorm() < cutoff2)
+          f(particles_[p]);
     }
     int a = 0;
     for (; a < D; ++a) {

@@ -37,7 +37,8 @@ std::string SceneSource::locate(const std::string& key_path) const {
     if (overridden_.count(path)) return file_ + ": --set " + path;
     auto it = lines_.find(path);
     if (it != lines_.end())
-      return file_ + ":" + std::to_string(it->second.first) + ":" + std::to_string(it->second.second);
+      return file_ + ":" + std::to_string(it->second.first) + ":" +
+             std::to_string(it->second.second);
     if (path.empty()) return file_;
     const auto cut = path.find_last_of(".[");
     path = cut == std::string::npos ? std::string() : path.substr(0, cut);
@@ -141,11 +142,13 @@ class Translator {
       case F::CPPTYPE_UINT64: {
         const long long v = to_integer(text, path, field);
         if (field->cpp_type() == F::CPPTYPE_INT32)
-          add ? r->AddInt32(&msg, field, static_cast<int>(v)) : r->SetInt32(&msg, field, static_cast<int>(v));
+          add ? r->AddInt32(&msg, field, static_cast<int>(v))
+              : r->SetInt32(&msg, field, static_cast<int>(v));
         else if (field->cpp_type() == F::CPPTYPE_INT64)
           add ? r->AddInt64(&msg, field, v) : r->SetInt64(&msg, field, v);
         else if (field->cpp_type() == F::CPPTYPE_UINT32)
-          add ? r->AddUInt32(&msg, field, static_cast<unsigned>(v)) : r->SetUInt32(&msg, field, static_cast<unsigned>(v));
+          add ? r->AddUInt32(&msg, field, static_cast<unsigned>(v))
+              : r->SetUInt32(&msg, field, static_cast<unsigned>(v));
         else
           add ? r->AddUInt64(&msg, field, v) : r->SetUInt64(&msg, field, v);
         break;
@@ -191,10 +194,12 @@ class Translator {
     auto [ptr, ec] = std::from_chars(text.data(), end, v);
     if (ec != std::errc() || ptr != end) fail(path, "expected an integer, got '" + text + "'");
     using F = gp::FieldDescriptor;
-    const bool is_unsigned = field->cpp_type() == F::CPPTYPE_UINT32 || field->cpp_type() == F::CPPTYPE_UINT64;
-    const bool is32 = field->cpp_type() == F::CPPTYPE_INT32 || field->cpp_type() == F::CPPTYPE_UINT32;
-    if ((is_unsigned && v < 0) || (is32 && (v > std::numeric_limits<int>::max() ||
-                                            v < std::numeric_limits<int>::min())))
+    const bool is_unsigned =
+        field->cpp_type() == F::CPPTYPE_UINT32 || field->cpp_type() == F::CPPTYPE_UINT64;
+    const bool is32 =
+        field->cpp_type() == F::CPPTYPE_INT32 || field->cpp_type() == F::CPPTYPE_UINT32;
+    if ((is_unsigned && v < 0) ||
+        (is32 && (v > std::numeric_limits<int>::max() || v < std::numeric_limits<int>::min())))
       fail(path, "integer out of range: " + text);
     return v;
   }
@@ -257,9 +262,10 @@ class Validator {
         const int n = r->FieldSize(msg, field);
         if (rule.required() && n == 0) fail(child, "required: give at least one value");
         if (n > 0 && rule.dimension_sized() && n != dimension_)
-          fail(child, "expected " + std::to_string(dimension_) + " values (the scene's dimension), got " +
-                          std::to_string(n));
-        for (int e = 0; e < n; ++e) element(msg, field, rule, child + "[" + std::to_string(e) + "]", e);
+          fail(child, "expected " + std::to_string(dimension_) +
+                          " values (the scene's dimension), got " + std::to_string(n));
+        for (int e = 0; e < n; ++e)
+          element(msg, field, rule, child + "[" + std::to_string(e) + "]", e);
       } else {
         if (!r->HasField(msg, field)) {
           if (rule.required()) fail(child, "required key '" + field->name() + "' is missing");
@@ -279,10 +285,12 @@ class Validator {
     double v = 0.0;
     switch (field->cpp_type()) {
       case F::CPPTYPE_MESSAGE:
-        check(index < 0 ? r->GetMessage(msg, field) : r->GetRepeatedMessage(msg, field, index), path);
+        check(index < 0 ? r->GetMessage(msg, field) : r->GetRepeatedMessage(msg, field, index),
+              path);
         return;
       case F::CPPTYPE_STRING: {
-        const std::string s = index < 0 ? r->GetString(msg, field) : r->GetRepeatedString(msg, field, index);
+        const std::string s =
+            index < 0 ? r->GetString(msg, field) : r->GetRepeatedString(msg, field, index);
         if (rule.one_of_size() > 0) {
           bool ok = false;
           std::string allowed;
@@ -301,7 +309,8 @@ class Validator {
         v = index < 0 ? r->GetInt32(msg, field) : r->GetRepeatedInt32(msg, field, index);
         break;
       case F::CPPTYPE_INT64:
-        v = static_cast<double>(index < 0 ? r->GetInt64(msg, field) : r->GetRepeatedInt64(msg, field, index));
+        v = static_cast<double>(index < 0 ? r->GetInt64(msg, field)
+                                          : r->GetRepeatedInt64(msg, field, index));
         break;
       default:
         return;
@@ -309,8 +318,10 @@ class Validator {
     std::ostringstream got;
     got.precision(17);
     got << v;
-    if (rule.has_min() && !(v >= rule.min())) fail(path, "must be >= " + num(rule.min()) + ", got " + got.str());
-    if (rule.has_max() && !(v <= rule.max())) fail(path, "must be <= " + num(rule.max()) + ", got " + got.str());
+    if (rule.has_min() && !(v >= rule.min()))
+      fail(path, "must be >= " + num(rule.min()) + ", got " + got.str());
+    if (rule.has_max() && !(v <= rule.max()))
+      fail(path, "must be <= " + num(rule.max()) + ", got " + got.str());
     if (rule.has_greater_than() && !(v > rule.greater_than()))
       fail(path, "must be > " + num(rule.greater_than()) + ", got " + got.str());
     if (rule.has_less_than() && !(v < rule.less_than()))
@@ -357,19 +368,20 @@ std::vector<Segment> split_path(const std::string& path) {
 }
 
 // Applies "a.b[0].c=value" to the YAML tree. Returns the canonical key path that was set.
-std::string apply_override(YAML::Node& root, const std::string& assignment, const SceneSource& source) {
+std::string apply_override(YAML::Node& root, const std::string& assignment,
+                           const SceneSource& source) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
-    throw SceneError(assignment, source.file() + ": --set " + assignment +
-                                     ": expected key.path=value");
+    throw SceneError(assignment,
+                     source.file() + ": --set " + assignment + ": expected key.path=value");
   const std::string path = assignment.substr(0, eq);
   const std::string text = assignment.substr(eq + 1);
   YAML::Node value;
   try {
     value = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw SceneError(path, source.file() + ": --set " + path + ": cannot parse value '" + text +
-                               "': " + e.msg);
+    throw SceneError(
+        path, source.file() + ": --set " + path + ": cannot parse value '" + text + "': " + e.msg);
   }
   std::vector<Segment> segments;
   try {
@@ -398,7 +410,8 @@ std::string apply_override(YAML::Node& root, const std::string& assignment, cons
       continue;
     }
     if (!node.IsSequence())
-      throw SceneError(path, source.file() + ": --set " + path + ": '" + canonical + "' is not a list");
+      throw SceneError(path,
+                       source.file() + ": --set " + path + ": '" + canonical + "' is not a list");
     std::size_t index = node.size();
     const std::string& sel = seg.selector;
     if (!sel.empty() && std::all_of(sel.begin(), sel.end(), ::isdigit)) {
@@ -408,8 +421,8 @@ std::string apply_override(YAML::Node& root, const std::string& assignment, cons
         if (node[e].IsMap() && node[e]["name"] && node[e]["name"].Scalar() == sel) index = e;
     }
     if (index >= node.size())
-      throw SceneError(path, source.file() + ": --set " + path + ": '" + canonical + "' has no element [" +
-                                 sel + "]");
+      throw SceneError(path, source.file() + ": --set " + path + ": '" + canonical +
+                                 "' has no element [" + sel + "]");
     canonical += "[" + std::to_string(index) + "]";
     if (last) {
       node[index] = value;

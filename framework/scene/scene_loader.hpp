@@ -29,7 +29,9 @@ class SceneSource {
   std::string locate(const std::string& key_path) const;
   // "file:line:col: key.path: message" — the one format for every scene error.
   std::string format(const std::string& key_path, const std::string& message) const;
-  std::string format(const ConfigError& error) const { return format(error.key_path(), error.what()); }
+  std::string format(const ConfigError& error) const {
+    return format(error.key_path(), error.what());
+  }
 
  private:
   std::string file_;
@@ -49,7 +51,8 @@ class SceneError : public ConfigError {
 };
 
 // Loads, overrides and validates. Throws SceneError.
-LoadedScene load_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
+LoadedScene load_scene_file(const std::string& path,
+                            const std::vector<std::string>& overrides = {});
 LoadedScene load_scene_text(const std::string& text, const std::string& name,
                             const std::vector<std::string>& overrides = {});
 

@@ -67,13 +67,16 @@ class DiffusionModule final : public Module {
     particles_.resize(cloud.positions.size());
     auto& x = particles_.add_vector("position", {.output = true});
     auto& V = particles_.add_scalar("volume", {.output = true});
-    auto& c = particles_.add_scalar(spec_.field(), {.output = true, .checkpoint = true, .exchange = true});
+    auto& c = particles_.add_scalar(spec_.field(),
+                                    {.output = true, .checkpoint = true, .exchange = true});
     for (std::size_t k = 0; k < order.size(); ++k) {
-      x[k] = domain_.any_periodic() ? domain_.wrap(cloud.positions[order[k]]) : cloud.positions[order[k]];
+      x[k] = domain_.any_periodic() ? domain_.wrap(cloud.positions[order[k]])
+                                    : cloud.positions[order[k]];
       V[k] = cloud.volumes[order[k]];
     }
 
-    const Expression initial = parse_expression(spec_.initial(), kSpaceTimeVariables, key_ + ".initial");
+    const Expression initial =
+        parse_expression(spec_.initial(), kSpaceTimeVariables, key_ + ".initial");
     for (std::size_t i = 0; i < x.size(); ++i) {
       const auto p = point(x[i], 0.0);
       c[i] = initial.evaluate(std::span<const double>(p.data(), p.size()));
@@ -85,7 +88,8 @@ class DiffusionModule final : public Module {
       auto shape = build_shape<D>(fv.region().shape(), path + ".region.shape");
       Fixed fixed{select_region<D>(x, *shape),
                   parse_expression(fv.value(), kSpaceTimeVariables, path + ".value")};
-      if (fixed.particles.empty()) throw ConfigError(path + ".region", "the region contains no particle");
+      if (fixed.particles.empty())
+        throw ConfigError(path + ".region", "the region contains no particle");
       fixed_.push_back(std::move(fixed));
     }
     apply_fixed_values();
@@ -93,7 +97,8 @@ class DiffusionModule final : public Module {
     neighbours_ = build_inner_list<D>(x, kernel_.support_radius(), domain_);
     const std::vector<Mat<D>> tensors(x.size(), tensor);
     try {
-      weights_ = diffusion_pair_weights<D>(x, V, neighbours_, kernel_, domain_, tensors, spec_.kernel_correction());
+      weights_ = diffusion_pair_weights<D>(x, V, neighbours_, kernel_, domain_, tensors,
+                                           spec_.kernel_correction());
     } catch (const RuntimeError& e) {
       throw RuntimeError("module '" + name_ + "': " + e.what());
     }
@@ -106,7 +111,8 @@ class DiffusionModule final : public Module {
     double row_max = 0.0;
     for (std::size_t i = 0; i < x.size(); ++i) {
       double row = 0.0;
-      for (std::size_t k = neighbours_.offset[i]; k < neighbours_.offset[i + 1]; ++k) row += weights_[k];
+      for (std::size_t k = neighbours_.offset[i]; k < neighbours_.offset[i + 1]; ++k)
+        row += weights_[k];
       row_max = std::max(row_max, row);
     }
     max_dt_ = row_max > 0.0 ? std::min(paper, 1.0 / row_max) : paper;
@@ -136,7 +142,8 @@ class DiffusionModule final : public Module {
     check_port(port);
     auto it = in.arrays.find(spec_.field());
     if (it == in.arrays.end() || in.points != particles_.size() || it->second.components != 1)
-      throw RuntimeError("module '" + name_ + "': port '" + port + "' got a buffer of another shape");
+      throw RuntimeError("module '" + name_ + "': port '" + port +
+                         "' got a buffer of another shape");
     particles_.scalar(spec_.field()) = it->second.values;
   }
 
@@ -199,7 +206,8 @@ class DiffusionModule final : public Module {
 
   void check_port(const std::string& port) const {
     if (port != spec_.field())
-      throw RuntimeError("module '" + name_ + "' has no port '" + port + "' (it has '" + spec_.field() + "')");
+      throw RuntimeError("module '" + name_ + "' has no port '" + port + "' (it has '" +
+                         spec_.field() + "')");
   }
 
   std::string name_, key_;

@@ -6,7 +6,6 @@
 #include <sstream>
 
 #include "core/error.hpp"
-
 #include "core/parallel.hpp"
 
 namespace cosph {
@@ -39,7 +38,6 @@ Mat<D> diffusion_second_moment(std::size_t i, const std::vector<Vec<D>>& positio
   return S;
 }
 
-
 template <int D>
 std::vector<double> diffusion_pair_weights(const std::vector<Vec<D>>& positions,
                                            const std::vector<double>& volumes,
@@ -62,15 +60,18 @@ std::vector<double> diffusion_pair_weights(const std::vector<Vec<D>>& positions,
       const double scale = target.norm();
       Mat<D> a = target;
       for (int iteration = 0; iteration < 50; ++iteration) {
-        const Mat<D> S = diffusion_second_moment<D>(i, positions, volumes, neighbours, kernel, domain, a);
+        const Mat<D> S =
+            diffusion_second_moment<D>(i, positions, volumes, neighbours, kernel, domain, a);
         const Mat<D> residual = target - S;
         if (residual.norm() < 1e-12 * scale || !(S.trace() > 0.0)) break;
         a += (a.trace() / S.trace()) * residual;
         // Clamp the eigenvalues of D^-1/2 A D^-1/2 to [1/k, k].
         const Mat<D> m = inverse_root * (0.5 * (a + a.transpose())) * inverse_root;
         const Eigen::SelfAdjointEigenSolver<Mat<D>> em(m);
-        const Vec<D> clamped = em.eigenvalues().cwiseMax(1.0 / kMaxCorrection).cwiseMin(kMaxCorrection);
-        a = root * (em.eigenvectors() * clamped.asDiagonal() * em.eigenvectors().transpose()) * root;
+        const Vec<D> clamped =
+            em.eigenvalues().cwiseMax(1.0 / kMaxCorrection).cwiseMin(kMaxCorrection);
+        a = root * (em.eigenvectors() * clamped.asDiagonal() * em.eigenvectors().transpose()) *
+            root;
       }
       A[i] = a;
     });
@@ -82,7 +83,8 @@ std::vector<double> diffusion_pair_weights(const std::vector<Vec<D>>& positions,
       const Vec<D> rij = domain.displacement(positions[i], positions[j]);
       const double r = rij.norm();
       const Mat<D> Aij = 0.5 * (A[i] + A[j]);
-      const double g = anisotropic_pair_factor<D>(Aij.inverse(), 1.0 / std::sqrt(Aij.determinant()), rij / r);
+      const double g =
+          anisotropic_pair_factor<D>(Aij.inverse(), 1.0 / std::sqrt(Aij.determinant()), rij / r);
       weights[k] = 2.0 * volumes[j] * (-kernel.derivative(r) / r) * g;
     }
   });
@@ -101,13 +103,13 @@ void apply_diffusion(const NeighbourList& neighbours, const std::vector<double>&
   });
 }
 
-#define COSPH_INSTANTIATE(D)                                                                   \
-  template double anisotropic_pair_factor<D>(const Mat<D>&, double, const Vec<D>&);          \
-  template std::vector<double> diffusion_pair_weights<D>(                                     \
-      const std::vector<Vec<D>>&, const std::vector<double>&, const NeighbourList&,           \
-      const Kernel&, const Domain<D>&, const std::vector<Mat<D>>&, bool);                    \
-  template Mat<D> diffusion_second_moment<D>(std::size_t, const std::vector<Vec<D>>&,          \
-                                             const std::vector<double>&, const NeighbourList&, \
+#define COSPH_INSTANTIATE(D)                                                                       \
+  template double anisotropic_pair_factor<D>(const Mat<D>&, double, const Vec<D>&);                \
+  template std::vector<double> diffusion_pair_weights<D>(                                          \
+      const std::vector<Vec<D>>&, const std::vector<double>&, const NeighbourList&, const Kernel&, \
+      const Domain<D>&, const std::vector<Mat<D>>&, bool);                                         \
+  template Mat<D> diffusion_second_moment<D>(std::size_t, const std::vector<Vec<D>>&,              \
+                                             const std::vector<double>&, const NeighbourList&,     \
                                              const Kernel&, const Domain<D>&, const Mat<D>&);
 COSPH_INSTANTIATE(2)
 COSPH_INSTANTIATE(3)

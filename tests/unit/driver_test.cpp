@@ -80,7 +80,8 @@ TEST(Driver, RestartFromCheckpointIsBitIdenticalToUninterruptedRun) {
   restart.restart_file = checkpoint.string();
   const std::vector<double> continued = final_field(scene, restart);
   ASSERT_EQ(continued.size(), uninterrupted.size());
-  for (std::size_t i = 0; i < continued.size(); ++i) ASSERT_EQ(continued[i], uninterrupted[i]) << "particle " << i;
+  for (std::size_t i = 0; i < continued.size(); ++i)
+    ASSERT_EQ(continued[i], uninterrupted[i]) << "particle " << i;
   // The test has teeth: the state at t = 1 differs from the final one.
   RunOptions half;
   half.bench = true;
@@ -112,7 +113,8 @@ TEST(Driver, DamagedOrForeignCheckpointIsRefused) {
     b << in.rdbuf();
     bytes = b.str();
   }
-  auto refused = [&](const std::string& content, const std::string& scene_file, const std::string& expect) {
+  auto refused = [&](const std::string& content, const std::string& scene_file,
+                     const std::string& expect) {
     const fs::path bad = dir / "bad.ckpt";
     std::ofstream(bad, std::ios::binary) << content;
     RunOptions options;
@@ -142,7 +144,8 @@ TEST(Driver, OutputFilesAreWritten) {
   RunOptions options;
   options.output_directory = (dir / "out").string();
   final_field(scene, options);
-  for (const char* f : {"blob.pvd", "blob_000000.vtp", "blob_000004.vtp", "point.csv", "total.csv", "summary.json"})
+  for (const char* f :
+       {"blob.pvd", "blob_000000.vtp", "blob_000004.vtp", "point.csv", "total.csv", "summary.json"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
   std::ifstream csv(dir / "out" / "total.csv");
   std::string header;
@@ -178,12 +181,17 @@ TEST(CommandLine, ExitCodesAndMessages) {
   EXPECT_NE(err.find("outside the domain"), std::string::npos) << err;
   // A probe outside the domain.
   EXPECT_EQ(cli({"check", scene, "--set", "probes[0].points.at=[[1.5, 0.5]]"}, &err), 2);
-  EXPECT_NE(err.find("probes[0].points.at[0]: probe point lies outside the domain"), std::string::npos) << err;
+  EXPECT_NE(err.find("probes[0].points.at[0]: probe point lies outside the domain"),
+            std::string::npos)
+      << err;
   // A fixed-value region that holds no particle.
   EXPECT_EQ(cli({"check", scene, "--set",
-                 "modules[0].diffusion.fixed_values[0].region.shape={box: {lower: [2, 2], upper: [3, 3]}}"},
-                &err), 2);
-  EXPECT_NE(err.find("fixed_values[0].region: the region contains no particle"), std::string::npos) << err;
+                 "modules[0].diffusion.fixed_values[0].region.shape={box: {lower: [2, 2], upper: "
+                 "[3, 3]}}"},
+                &err),
+            2);
+  EXPECT_NE(err.find("fixed_values[0].region: the region contains no particle"), std::string::npos)
+      << err;
   // Unreadable geometry: a missing point cloud file.
   std::string csv_scene = kScene;
   const auto at = csv_scene.find("        shape:");
@@ -197,7 +205,9 @@ TEST(CommandLine, ExitCodesAndMessages) {
   EXPECT_NE(err.find("modules[0].diffusion.initial"), std::string::npos) << err;
   EXPECT_NE(err.find("unknown identifier 'q'"), std::string::npos) << err;
   // Missing restart file: run-time error, exit code 1.
-  EXPECT_EQ(cli({"run", scene, "--bench", "--quiet", "--restart", (dir / "nope.ckpt").string()}, &err), 1);
+  EXPECT_EQ(
+      cli({"run", scene, "--bench", "--quiet", "--restart", (dir / "nope.ckpt").string()}, &err),
+      1);
   EXPECT_NE(err.find("nope.ckpt: cannot open"), std::string::npos) << err;
 }
 

@@ -1,10 +1,11 @@
 // The corrected kernel gradient is exact for linear fields at every particle, boundaries included.
+#include "kernels/kernel_correction.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "core/error.hpp"
-#include "kernels/kernel_correction.hpp"
 #include "neighbour/cell_linked_list.hpp"
 
 namespace cosph {

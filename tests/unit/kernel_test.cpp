@@ -1,10 +1,10 @@
 // Kernels: normalisation, derivative, compact support and convergence of SPH interpolation.
+#include "kernels/kernel.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
-
-#include "kernels/kernel.hpp"
 
 namespace cosph {
 namespace {
@@ -19,8 +19,8 @@ double radial_integral(const Kernel& w) {
   double sum = 0.0;
   for (int k = 0; k <= n; ++k) {
     const double r = k * dr;
-    const double shell = w.dimension() == 2 ? 2.0 * std::numbers::pi * r
-                                            : 4.0 * std::numbers::pi * r * r;
+    const double shell =
+        w.dimension() == 2 ? 2.0 * std::numbers::pi * r : 4.0 * std::numbers::pi * r * r;
     const double weight = (k == 0 || k == n) ? 1.0 : (k % 2 ? 4.0 : 2.0);
     sum += weight * w.value(r) * shell;
   }
@@ -43,7 +43,8 @@ TEST(Kernel, DerivativeMatchesCentralDifferenceOfValue) {
       for (double r = 0.01; r < w.support_radius(); r += 0.0371) {
         const double eps = 1e-6;
         const double fd = (w.value(r + eps) - w.value(r - eps)) / (2 * eps);
-        EXPECT_NEAR(w.derivative(r), fd, 1e-6 * (1.0 + std::abs(fd))) << kernel_name(t) << " r=" << r;
+        EXPECT_NEAR(w.derivative(r), fd, 1e-6 * (1.0 + std::abs(fd)))
+            << kernel_name(t) << " r=" << r;
       }
     }
 }

@@ -1,8 +1,8 @@
 // Scene files: every kind of bad input stops with a message naming the file, the line and the
 // key path; overrides are checked like the file itself.
-#include <gtest/gtest.h>
-
 #include "scene/scene_loader.hpp"
+
+#include <gtest/gtest.h>
 
 namespace cosph {
 namespace {
@@ -66,8 +66,10 @@ TEST(SceneLoader, WrongTypeIsAnError) {
   EXPECT_CONTAINS(msg, "scene.yaml:8:");
   EXPECT_CONTAINS(msg, "modules[0].diffusion.body.spacing");
   EXPECT_CONTAINS(msg, "expected a number, got 'fine'");
-  EXPECT_CONTAINS(error_of(replace(kValid, "dimension: 2", "dimension: 2.5")), "expected an integer");
-  EXPECT_CONTAINS(error_of(replace(kValid, "end_time: 1.0", "end_time: [1]")), "expected a number, got a list");
+  EXPECT_CONTAINS(error_of(replace(kValid, "dimension: 2", "dimension: 2.5")),
+                  "expected an integer");
+  EXPECT_CONTAINS(error_of(replace(kValid, "end_time: 1.0", "end_time: [1]")),
+                  "expected a number, got a list");
   EXPECT_CONTAINS(error_of(replace(kValid, "box: {lower: [0, 0], upper: [1, 1]}", "box: 3")),
                   "expected a mapping of keys");
 }
@@ -83,13 +85,16 @@ TEST(SceneLoader, MissingRequiredValueIsAnError) {
 }
 
 TEST(SceneLoader, NonPhysicalNumbersAreErrors) {
-  EXPECT_CONTAINS(error_of(replace(kValid, "end_time: 1.0", "end_time: -1")), "must be > 0, got -1");
+  EXPECT_CONTAINS(error_of(replace(kValid, "end_time: 1.0", "end_time: -1")),
+                  "must be > 0, got -1");
   EXPECT_CONTAINS(error_of(replace(kValid, "end_time: 1.0", "end_time: 0")), "must be > 0");
   EXPECT_CONTAINS(error_of(replace(kValid, "spacing: 0.05", "spacing: -0.05")),
                   "modules[0].diffusion.body.spacing: must be > 0");
-  EXPECT_CONTAINS(error_of(replace(kValid, "diffusivity: 1.0e-3", "diffusivity: -2")), "must be > 0");
+  EXPECT_CONTAINS(error_of(replace(kValid, "diffusivity: 1.0e-3", "diffusivity: -2")),
+                  "must be > 0");
   EXPECT_CONTAINS(error_of(replace(kValid, "dimension: 2", "dimension: 4")), "must be <= 3");
-  EXPECT_CONTAINS(error_of(replace(kValid, "end_time: 1.0", "end_time: .nan")), "expected a number");
+  EXPECT_CONTAINS(error_of(replace(kValid, "end_time: 1.0", "end_time: .nan")),
+                  "expected a number");
 }
 
 TEST(SceneLoader, ListLengthMustMatchDimension) {
@@ -99,14 +104,16 @@ TEST(SceneLoader, ListLengthMustMatchDimension) {
 }
 
 TEST(SceneLoader, ExclusiveChoicesAreErrors) {
-  const std::string text = replace(kValid, "    points: {at: [[0.5, 0.5]], fields: [concentration]}",
-                                   "    points: {at: [[0.5, 0.5]], fields: [concentration]}\n"
-                                   "    reduce: {quantity: integral, field: concentration}");
+  const std::string text =
+      replace(kValid, "    points: {at: [[0.5, 0.5]], fields: [concentration]}",
+              "    points: {at: [[0.5, 0.5]], fields: [concentration]}\n"
+              "    reduce: {quantity: integral, field: concentration}");
   EXPECT_CONTAINS(error_of(text), "exclude each other");
 }
 
 TEST(SceneLoader, ValueOutsideAllowedSetIsAnError) {
-  const std::string text = replace(kValid, "        spacing: 0.05", "        spacing: 0.05\n        kernel: {type: gauss}");
+  const std::string text = replace(kValid, "        spacing: 0.05",
+                                   "        spacing: 0.05\n        kernel: {type: gauss}");
   const std::string msg = error_of(text);
   EXPECT_CONTAINS(msg, "modules[0].diffusion.body.kernel.type");
   EXPECT_CONTAINS(msg, "'gauss' is not one of");
@@ -128,17 +135,19 @@ TEST(SceneLoader, UnreadableFileIsAnError) {
 }
 
 TEST(SceneLoader, OverridesReplaceValuesByIndexOrName) {
-  auto s = load_scene_text(kValid, "scene.yaml", {"modules[0].diffusion.body.spacing=0.025", "end_time=3"});
+  auto s = load_scene_text(kValid, "scene.yaml",
+                           {"modules[0].diffusion.body.spacing=0.025", "end_time=3"});
   EXPECT_DOUBLE_EQ(s.scene.modules(0).diffusion().body().spacing(), 0.025);
   EXPECT_DOUBLE_EQ(s.scene.end_time(), 3.0);
-  s = load_scene_text(kValid, "scene.yaml", {"modules[heat].diffusion.kernel_correction=false",
-                                             "output.interval=0.5"});
+  s = load_scene_text(kValid, "scene.yaml",
+                      {"modules[heat].diffusion.kernel_correction=false", "output.interval=0.5"});
   EXPECT_FALSE(s.scene.modules(0).diffusion().kernel_correction());
   EXPECT_DOUBLE_EQ(s.scene.output().interval(), 0.5);
 }
 
 TEST(SceneLoader, BadOverridesAreCheckedLikeTheFile) {
-  EXPECT_CONTAINS(error_of(kValid, {"modules[0].diffusion.body.spacing=-1"}), "--set modules[0].diffusion.body.spacing");
+  EXPECT_CONTAINS(error_of(kValid, {"modules[0].diffusion.body.spacing=-1"}),
+                  "--set modules[0].diffusion.body.spacing");
   EXPECT_CONTAINS(error_of(kValid, {"modules[0].diffusion.body.spacing=-1"}), "must be > 0");
   EXPECT_CONTAINS(error_of(kValid, {"modules[0].diffusion.bogus=1"}), "unknown key 'bogus'");
   EXPECT_CONTAINS(error_of(kValid, {"modules[7].diffusion.diffusivity=1"}), "has no element [7]");

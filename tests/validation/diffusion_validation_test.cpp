@@ -12,7 +12,9 @@
 namespace cosph {
 namespace {
 
-std::string example(const std::string& name) { return std::string(COSPH_SOURCE_DIR) + "/examples/" + name; }
+std::string example(const std::string& name) {
+  return std::string(COSPH_SOURCE_DIR) + "/examples/" + name;
+}
 
 // Runs a scene without files and returns the relative L2 error of its first body's
 // `concentration` against exact(x, y, t_end):  sqrt(sum V (c - exact)^2 / sum V exact^2).
@@ -55,13 +57,16 @@ double anisotropic_exact(double x, double y, double t) {
   const Eigen::Matrix2d sigma0 = s0 * s0 * Eigen::Matrix2d::Identity();
   const Eigen::Matrix2d sigma = sigma0 + 2.0 * t * D;
   const Eigen::Vector2d r(x - 0.5, y - 0.5);
-  return std::sqrt(sigma0.determinant() / sigma.determinant()) * std::exp(-0.5 * r.dot(sigma.inverse() * r));
+  return std::sqrt(sigma0.determinant() / sigma.determinant()) *
+         std::exp(-0.5 * r.dot(sigma.inverse() * r));
 }
 
 TEST(DiffusionValidation, TopHatErrorIsSmallAndFallsWithResolution) {
   const auto scene = example("diffusion_1d_tophat.yaml");
-  const double coarse = relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.02"}, tophat_exact);
-  const double fine = relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, tophat_exact);
+  const double coarse =
+      relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.02"}, tophat_exact);
+  const double fine =
+      relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, tophat_exact);
   RecordProperty("coarse", std::to_string(coarse));
   RecordProperty("fine", std::to_string(fine));
   std::cout << "top hat relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine << "\n";
@@ -71,9 +76,12 @@ TEST(DiffusionValidation, TopHatErrorIsSmallAndFallsWithResolution) {
 
 TEST(DiffusionValidation, AnisotropicGaussianErrorIsSmallAndFallsWithResolution) {
   const auto scene = example("diffusion_2d_anisotropic.yaml");
-  const double coarse = relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.02"}, anisotropic_exact);
-  const double fine = relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
-  std::cout << "anisotropic Gaussian relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine << "\n";
+  const double coarse =
+      relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.02"}, anisotropic_exact);
+  const double fine =
+      relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
+  std::cout << "anisotropic Gaussian relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine
+            << "\n";
   EXPECT_LT(fine, 0.002);
   EXPECT_LT(fine, 0.3 * coarse);  // at least second order: halving dp divides the error by 4
 }
@@ -83,10 +91,14 @@ TEST(DiffusionValidation, KernelCorrectionIsWhatMakesAnisotropicDiffusionConverg
   // directions only, and the error stays at a few percent however fine the particles are.
   const auto scene = example("diffusion_2d_anisotropic.yaml");
   const std::string off = "modules[0].diffusion.kernel_correction=false";
-  const double coarse = relative_l2_error(scene, {off, "modules[0].diffusion.body.spacing=0.02"}, anisotropic_exact);
-  const double fine = relative_l2_error(scene, {off, "modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
-  const double corrected = relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
-  std::cout << "uncorrected: dp=0.02 " << coarse << ", dp=0.01 " << fine << "; corrected dp=0.01 " << corrected << "\n";
+  const double coarse =
+      relative_l2_error(scene, {off, "modules[0].diffusion.body.spacing=0.02"}, anisotropic_exact);
+  const double fine =
+      relative_l2_error(scene, {off, "modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
+  const double corrected =
+      relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
+  std::cout << "uncorrected: dp=0.02 " << coarse << ", dp=0.01 " << fine << "; corrected dp=0.01 "
+            << corrected << "\n";
   EXPECT_GT(fine, 0.5 * coarse);
   EXPECT_LT(corrected, 0.1 * fine);
 }
@@ -105,7 +117,8 @@ TEST(DiffusionValidation, TotalAmountIsConservedToRoundOff) {
     simulation.module(0).bodies(v);
     const auto& p = *v.bodies2[0].particles;
     double s = 0.0;
-    for (std::size_t i = 0; i < p.size(); ++i) s += p.scalar("volume")[i] * p.scalar("concentration")[i];
+    for (std::size_t i = 0; i < p.size(); ++i)
+      s += p.scalar("volume")[i] * p.scalar("concentration")[i];
     return s;
   };
   const double before = total();
