@@ -76,7 +76,10 @@ std::array<int, D> CellLinkedList<D>::cell_of_position(const Vec<D>& x) const {
     if (domain_.periodic[a]) width = domain_.length(a) / cells_[a];
     double s = (x[a] - origin_[a]) / width;
     if (domain_.periodic[a]) s -= cells_[a] * std::floor(s / cells_[a]);
-    c[a] = std::clamp(static_cast<int>(std::floor(s)), 0, cells_[a] - 1);
+    // Clamp in floating point first: converting a far-away (or NaN) coordinate to int is UB.
+    const double clamped =
+        std::isnan(s) ? 0.0 : std::clamp(std::floor(s), 0.0, double(cells_[a] - 1));
+    c[a] = static_cast<int>(clamped);
   }
   return c;
 }

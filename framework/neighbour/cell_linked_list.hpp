@@ -4,6 +4,8 @@
 // governs) and the cell-order permutation that sorts particles for memory locality.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <vector>
 
 #include "core/types.hpp"
@@ -15,8 +17,9 @@ namespace cosph {
 template <int D>
 class CellLinkedList {
  public:
-  // Bins `positions`. On periodic axes the domain bounds are used (the axis must be at least
-  // three cut-offs long); on the others the cells span the particles' bounding box.
+  // Bins `positions` (kept by reference: they must outlive the list). On periodic axes the domain
+  // bounds are used (the axis must be at least three cut-offs long); on the others the cells span
+  // the particles' bounding box.
   CellLinkedList(const std::vector<Vec<D>>& positions, double cutoff, const Domain<D>& domain);
 
   // All particles of the binned set within `cutoff` of x (strictly closer), excluding `self`.

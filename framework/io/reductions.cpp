@@ -1,0 +1,64 @@
+#include "io/reductions.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "core/parallel.hpp"
+#include "io/required_field.hpp"
+
+namespace cosph {
+
+template <int D>
+double total_kinetic_energy(const ParticleSet<D>& particles) {
+  const auto& m = required_scalar(particles, "mass", "the kinetic energy");
+  const auto& v = required_vector(particles, "velocity", "the kinetic energy");
+  return deterministic_sum(particles.size(), 0.0,
+                           [&](std::size_t i) { return 0.5 * m[i] * v[i].squaredNorm(); });
+}
+
+template <int D>
+double extent(const ParticleSet<D>& particles, int axis) {
+  if (axis < 0 || axis >= D)
+    throw std::invalid_argument("extent: axis " + std::to_string(axis) + " out of range");
+  const auto& x = required_vector(particles, "position", "the extent");
+  if (x.empty()) return 0.0;
+  // min and max do not depend on the order of evaluation, so a plain loop is deterministic.
+  double lo = x[0][axis], hi = x[0][axis];
+  for (const auto& p : x) {
+    lo = std::min(lo, p[axis]);
+    hi = std::max(hi, p[axis]);
+  }
+  return hi - lo;
+}
+
+template <int D>
+Vec<D> total_vector(const ParticleSet<D>& particles, const std::string& field) {
+  const auto& f = required_vector(particles, field, "a total");
+  return deterministic_sum(particles.size(), Vec<D>(Vec<D>::Zero()),
+                           [&](std::size_t i) { return f[i]; });
+}
+
+template <int D>
+double total_scalar(const ParticleSet<D>& particles, const std::string& field) {
+  const auto& f = required_scalar(particles, field, "a total");
+  return deterministic_sum(particles.size(), 0.0, [&](std::size_t i) { return f[i]; });
+}
+
+template <int D>
+double integral(const ParticleSet<D>& particles, const std::string& scalar_field) {
+  const std::string purpose = "the integral of '" + scalar_field + "'";
+  const auto& volume = required_scalar(particles, "volume", purpose);
+  const auto& f = required_scalar(particles, scalar_field, purpose);
+  return deterministic_sum(particles.size(), 0.0, [&](std::size_t i) { return volume[i] * f[i]; });
+}
+
+#define COSPH_INSTANTIATE_REDUCTIONS(D)                                       \
+  template double total_kinetic_energy<D>(const ParticleSet<D>&);             \
+  template double extent<D>(const ParticleSet<D>&, int);                      \
+  template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&); \
+  template double total_scalar<D>(const ParticleSet<D>&, const std::string&); \
+  template double integral<D>(const ParticleSet<D>&, const std::string&);
+COSPH_INSTANTIATE_REDUCTIONS(2)
+COSPH_INSTANTIATE_REDUCTIONS(3)
+
+}  // namespace cosph

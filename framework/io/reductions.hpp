@@ -1,0 +1,46 @@
+// Whole-body quantities reduced over a ParticleSet, for time-series output and validation:
+// kinetic energy, extent, total force, integrals. Every sum goes through deterministic_sum, so
+// the results are bit-identical whatever the number of threads.
+#pragma once
+
+#include <string>
+
+#include "core/particles.hpp"
+#include "core/types.hpp"
+
+namespace cosph {
+
+// Sum of 0.5 m |v|^2 over the particles, from the scalar field "mass" and the vector field
+// "velocity". Throws cosph::RuntimeError naming the body and the missing field if either is
+// absent or of another kind.
+template <int D>
+double total_kinetic_energy(const ParticleSet<D>& particles);
+
+// max - min of the vector field "position" along `axis` (0 <= axis < D; std::invalid_argument
+// otherwise); 0 for an empty set. Throws cosph::RuntimeError if "position" is missing.
+template <int D>
+double extent(const ParticleSet<D>& particles, int axis);
+
+// Sum over the particles of a vector field (e.g. total force or momentum).
+template <int D>
+Vec<D> total_vector(const ParticleSet<D>& particles, const std::string& field);
+
+// Sum over the particles of a scalar field (e.g. total mass).
+template <int D>
+double total_scalar(const ParticleSet<D>& particles, const std::string& field);
+
+// SPH volume integral sum_i V_i f_i of a scalar field, with V_i from the scalar field "volume".
+template <int D>
+double integral(const ParticleSet<D>& particles, const std::string& scalar_field);
+
+#define COSPH_DECLARE_REDUCTIONS(D)                                                  \
+  extern template double total_kinetic_energy<D>(const ParticleSet<D>&);             \
+  extern template double extent<D>(const ParticleSet<D>&, int);                      \
+  extern template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&); \
+  extern template double total_scalar<D>(const ParticleSet<D>&, const std::string&); \
+  extern template double integral<D>(const ParticleSet<D>&, const std::string&);
+COSPH_DECLARE_REDUCTIONS(2)
+COSPH_DECLARE_REDUCTIONS(3)
+#undef COSPH_DECLARE_REDUCTIONS
+
+}  // namespace cosph
