@@ -1,6 +1,7 @@
 #include "driver/probe_set.hpp"
 
 #include <filesystem>
+#include <fstream>
 
 #include "core/error.hpp"
 #include "driver/scene_geometry.hpp"
@@ -32,6 +33,7 @@ struct ProbeSet::Probe {
   double interval = 0.0;
   std::vector<std::string> columns;
   std::vector<double> last;
+  std::vector<std::vector<double>> points;  // sampling points of point and line probes
   std::unique_ptr<CsvTimeSeries> csv;
   virtual ~Probe() = default;
   virtual std::vector<double> evaluate() const = 0;
@@ -110,6 +112,7 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
                     path + (line ? ".line" : ".points") + ".fields[" + std::to_string(k) + "]");
       auto entry = std::make_unique<PointProbeEntry<D>>(body, PointProbe<D>(points, names));
       entry->columns = entry->probe.columns();
+      for (const auto& p : points) entry->points.emplace_back(p.data(), p.data() + D);
       return entry;
     }
     case proto::ProbeSpec::kReduce: {
@@ -170,6 +173,17 @@ ProbeSet::ProbeSet(const proto::Scene& scene,
         throw ConfigError(path + ".name", "two probes named '" + spec.name() + "'");
     probe->name = spec.name();
     probe->interval = spec.interval();
+    if (!directory.empty() && !probe->points.empty()) {
+      // Sidecar with the sampling points, so that tools can place each column in space.
+      std::ofstream out(std::filesystem::path(directory) / (spec.name() + ".points.csv"));
+      out << "label,x,y" << (scene.dimension() == 3 ? ",z" : "") << "\n";
+      out.precision(17);
+      for (std::size_t k = 0; k < probe->points.size(); ++k) {
+        out << "p" << k;
+        for (double c : probe->points[k]) out << "," << c;
+        out << "\n";
+      }
+    }
     if (!directory.empty())
       probe->csv = std::make_unique<CsvTimeSeries>(
           (std::filesystem::path(directory) / (spec.name() + ".csv")).string(), probe->columns);
