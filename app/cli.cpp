@@ -27,6 +27,8 @@ options of run:
   --restart FILE         continue from a checkpoint file
   --bench                write no files; print steps and particle-steps per second
   --end-time T           stop at T instead of the scene's end_time
+  --health on|off        health monitor (default on, every run.health_interval steps): stops a
+                         run whose values turn non-finite or leave their physical bounds
   --quiet                no progress line
 )";
 
@@ -74,6 +76,10 @@ Arguments parse(const std::vector<std::string>& args) {
       a.options.restart_file = value();
     } else if (s == "--bench") {
       a.options.bench = true;
+    } else if (s == "--health") {
+      const std::string v = value();
+      if (v != "on" && v != "off") throw UsageError("--health expects on or off, got '" + v + "'");
+      a.options.health = v == "on";
     } else if (s == "--quiet") {
       a.options.progress = false;
     } else if (s == "--end-time") {

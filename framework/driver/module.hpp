@@ -6,6 +6,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,14 @@ struct StateRecord {
   std::map<std::string, long long> integers;
 };
 
+// A violated physical bound, found by a module's own health check.
+struct HealthProblem {
+  std::string quantity;  // e.g. "concentration", "J", "density"
+  long long particle = -1;
+  double value = 0.0;
+  std::string expected;  // e.g. "within [0, 1] (maximum principle)"
+};
+
 // What the driver may look at for output and probes: a module's bodies, in-process views.
 template <int D>
 struct BodyView {
@@ -86,6 +95,10 @@ class Module {
   // Bodies for output and probes; particle counts for the summary.
   virtual void bodies(BodyViews& views) const = 0;
   virtual std::size_t particle_count() const = 0;
+
+  // The module's own physical bounds (J > 0, density band, maximum principle...). The health
+  // monitor checks finiteness and the domain for every module itself.
+  virtual std::optional<HealthProblem> check_health() const { return std::nullopt; }
 };
 
 }  // namespace cosph

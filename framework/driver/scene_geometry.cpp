@@ -1,6 +1,7 @@
 #include "driver/scene_geometry.hpp"
 
 #include <filesystem>
+#include <random>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -93,11 +94,25 @@ ParticleCloud<D> build_body(const proto::BodySpec& spec, const std::string& key_
     }
   }
   auto shape = build_shape<D>(spec.shape(), key_path + ".shape");
+  ParticleCloud<D> cloud;
   try {
-    return lattice_fill<D>(*shape, spec.spacing(), to_vec<D>(spec.lattice_anchor()));
+    cloud = lattice_fill<D>(*shape, spec.spacing(), to_vec<D>(spec.lattice_anchor()));
   } catch (const std::invalid_argument& e) {
     throw ConfigError(key_path, e.what());
   }
+  if (spec.perturbation() > 0.0) {
+    // Uniform displacement in [-a, a] per axis, a = perturbation * spacing, from a fixed seed;
+    // particles pushed outside the shape are kept where they were.
+    std::mt19937_64 rng(spec.perturbation_seed());
+    std::uniform_real_distribution<double> u(-spec.perturbation() * spec.spacing(),
+                                             spec.perturbation() * spec.spacing());
+    for (auto& x : cloud.positions) {
+      Vec<D> moved = x;
+      for (int a = 0; a < D; ++a) moved[a] += u(rng);
+      if (shape->contains(moved)) x = moved;
+    }
+  }
+  return cloud;
 }
 
 template <int D>

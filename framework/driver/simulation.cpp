@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "driver/health_monitor.hpp"
 #include "driver/probe_set.hpp"
 #include "io/checkpoint_file.hpp"
 #include "io/pvd_collection.hpp"
@@ -346,6 +347,9 @@ RunSummary Simulation::run() {
     }
   };
 
+  const HealthMonitor health(options_.health ? s.run().health_interval() : 0, s.has_domain());
+  if (health.enabled()) health.check(modules_, I.steps, I.time);
+
   const auto wall_start = Clock::now();
   const std::clock_t cpu_start = std::clock();
   if (!restarted) {
@@ -393,9 +397,11 @@ RunSummary Simulation::run() {
     }
     I.time = reaches_target ? target : I.time + dt;
     ++I.steps;
+    if (health.due(I.steps)) health.check(modules_, I.steps, I.time);
     fire_due(I.time, false);
     progress(false);
   }
+  if (health.enabled()) health.check(modules_, I.steps, I.time);
   fire_due(I.time, true);
   if (files && s.checkpoint().at_end()) save_checkpoint("checkpoint_final.ckpt");
   progress(true);

@@ -21,6 +21,7 @@ struct RunOptions {
   bool bench = false;            // no files at all: steps and throughput only
   bool progress = true;          // progress line on stderr
   double end_time = -1.0;        // < 0: the scene's end_time (tests stop early with it)
+  bool health = true;            // run the health monitor (every run.health_interval steps)
 };
 
 struct ModuleTiming {

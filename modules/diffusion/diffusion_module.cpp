@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -51,6 +52,7 @@ class DiffusionModule final : public Module {
     info.active_features.push_back("kernel " + kernel_name(kernel_.type()));
     if (spec_.kernel_correction()) info.active_features.push_back("kernel correction");
     if (!fixed_.empty()) info.active_features.push_back("fixed values");
+    if (spec_.has_time_step()) info.active_features.push_back("fixed time step");
     return info;
   }
 
@@ -116,6 +118,33 @@ class DiffusionModule final : public Module {
       row_max = std::max(row_max, row);
     }
     max_dt_ = row_max > 0.0 ? std::min(paper, 1.0 / row_max) : paper;
+    if (spec_.has_time_step()) max_dt_ = spec_.time_step();
+
+    // Bounds for the health check: with positive weights and dt * sum_j w_ij <= 1 each step is a
+    // convex combination, so c stays within the range of its initial and boundary values
+    // (discrete maximum principle), and without fixed values sum_i V_i c_i^2 cannot grow.
+    lower_ = *std::min_element(c.begin(), c.end());
+    upper_ = *std::max_element(c.begin(), c.end());
+    initial_energy_ = energy();
+  }
+
+  std::optional<HealthProblem> check_health() const override {
+    const auto& c = particles_.scalar(spec_.field());
+    const double tolerance = 1e-9 * std::max(1.0, upper_ - lower_);
+    for (std::size_t i = 0; i < c.size(); ++i)
+      if (c[i] < lower_ - tolerance || c[i] > upper_ + tolerance) {
+        std::ostringstream expected;
+        expected << "within [" << lower_ << ", " << upper_ << "] (discrete maximum principle)";
+        return HealthProblem{spec_.field(), static_cast<long long>(i), c[i], expected.str()};
+      }
+    if (fixed_.empty()) {
+      const double e = energy();
+      if (e > initial_energy_ * (1.0 + 1e-9))
+        return HealthProblem{"sum V " + spec_.field() + "^2", -1, e,
+                             "at most its initial value " + std::to_string(initial_energy_) +
+                                 " (diffusion dissipates)"};
+    }
+    return std::nullopt;
   }
 
   double max_dt() const override { return max_dt_; }
@@ -149,6 +178,9 @@ class DiffusionModule final : public Module {
 
   void save(StateRecord& state) const override {
     state.arrays[spec_.field()] = particles_.scalar(spec_.field());
+    state.scalars["lower_bound"] = lower_;
+    state.scalars["upper_bound"] = upper_;
+    state.scalars["initial_energy"] = initial_energy_;
     state.scalars["time"] = time_;
     state.integers["steps"] = steps_;
   }
@@ -160,6 +192,9 @@ class DiffusionModule final : public Module {
                          std::to_string(particles_.size()) + " values of '" + spec_.field() + "'");
     particles_.scalar(spec_.field()) = it->second;
     time_ = state.scalars.at("time");
+    lower_ = state.scalars.at("lower_bound");
+    upper_ = state.scalars.at("upper_bound");
+    initial_energy_ = state.scalars.at("initial_energy");
     steps_ = state.integers.at("steps");
   }
 
@@ -201,7 +236,16 @@ class DiffusionModule final : public Module {
       for (Index i : f.particles) {
         const auto p = point(x[i], time_);
         c[i] = f.value.evaluate(std::span<const double>(p.data(), 4));
+        // Boundary values widen the range the maximum principle allows.
+        lower_ = std::min(lower_, c[i]);
+        upper_ = std::max(upper_, c[i]);
       }
+  }
+
+  double energy() const {
+    const auto& c = particles_.scalar(spec_.field());
+    const auto& V = particles_.scalar("volume");
+    return deterministic_sum(c.size(), 0.0, [&](std::size_t i) { return V[i] * c[i] * c[i]; });
   }
 
   void check_port(const std::string& port) const {
@@ -221,6 +265,7 @@ class DiffusionModule final : public Module {
   std::vector<double> weights_, rate_;
   std::vector<Fixed> fixed_;
   double max_dt_ = 0.0, time_ = 0.0;
+  double lower_ = INFINITY, upper_ = -INFINITY, initial_energy_ = 0.0;
   long long steps_ = 0;
 };
 
