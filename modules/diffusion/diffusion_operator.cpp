@@ -59,11 +59,11 @@ std::vector<double> diffusion_pair_weights(const std::vector<Vec<D>>& positions,
       const Mat<D> root = eigen.operatorSqrt(), inverse_root = eigen.operatorInverseSqrt();
       const double scale = target.norm();
       Mat<D> a = target;
-      for (int iteration = 0; iteration < 50; ++iteration) {
+      for (int iteration = 0; iteration < 30; ++iteration) {
         const Mat<D> S =
             diffusion_second_moment<D>(i, positions, volumes, neighbours, kernel, domain, a);
         const Mat<D> residual = target - S;
-        if (residual.norm() < 1e-12 * scale || !(S.trace() > 0.0)) break;
+        if (residual.norm() < 1e-10 * scale || !(S.trace() > 0.0)) break;
         a += (a.trace() / S.trace()) * residual;
         // Clamp the eigenvalues of D^-1/2 A D^-1/2 to [1/k, k].
         const Mat<D> m = inverse_root * (0.5 * (a + a.transpose())) * inverse_root;
