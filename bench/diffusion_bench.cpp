@@ -5,7 +5,7 @@
 
 #include <random>
 
-#include "diffusion/diffusion_operator.hpp"
+#include "operators/diffusion_operator.hpp"
 #include "kernels/kernel_correction.hpp"
 #include "neighbour/cell_linked_list.hpp"
 

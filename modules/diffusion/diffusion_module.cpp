@@ -7,7 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
-#include "diffusion/diffusion_operator.hpp"
+#include "operators/diffusion_operator.hpp"
 #include "driver/scene_geometry.hpp"
 #include "expression/expression.hpp"
 #include "geometry/regions.hpp"

@@ -1,4 +1,4 @@
-#include "diffusion/diffusion_operator.hpp"
+#include "operators/diffusion_operator.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
