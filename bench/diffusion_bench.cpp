@@ -5,9 +5,9 @@
 
 #include <random>
 
-#include "operators/diffusion_operator.hpp"
 #include "kernels/kernel_correction.hpp"
 #include "neighbour/cell_linked_list.hpp"
+#include "operators/diffusion_operator.hpp"
 
 namespace {
 

@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "geometry/lattice.hpp"
 #include "geometry/point_cloud_csv.hpp"
+#include "neighbour/cell_linked_list.hpp"
 
 namespace cosph {
 
@@ -152,14 +153,35 @@ void check_inside_domain(const proto::Scene& scene, const ParticleCloud<D>& clou
   }
 }
 
-#define COSPH_INSTANTIATE(D)                                                          \
-  template Vec<D> to_vec<D>(const google::protobuf::RepeatedField<double>&);          \
-  template ShapePtr<D> build_shape<D>(const proto::Shape&, const std::string&);       \
-  template ParticleCloud<D> build_body<D>(const proto::BodySpec&, const std::string&, \
-                                          const std::string&);                        \
-  template Domain<D> build_domain<D>(const proto::Scene&);                            \
-  template void check_inside_domain<D>(const proto::Scene&, const ParticleCloud<D>&,  \
-                                       const std::string&);
+template <int D>
+void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
+                       const std::string& key_path, const std::string& scene_directory,
+                       const Kernel& kernel, ParticleSet<D>& particles) {
+  const ParticleCloud<D> cloud = build_body<D>(spec, key_path, scene_directory);
+  check_inside_domain<D>(scene, cloud, key_path);
+  const Domain<D> domain = build_domain<D>(scene);
+  const auto order = cell_sort_order<D>(cloud.positions, kernel.support_radius(), domain);
+  particles.resize(cloud.positions.size());
+  auto& x = particles.add_vector("position", {.output = true});
+  auto& V = particles.add_scalar("volume", {.output = true});
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    x[k] =
+        domain.any_periodic() ? domain.wrap(cloud.positions[order[k]]) : cloud.positions[order[k]];
+    V[k] = cloud.volumes[order[k]];
+  }
+}
+
+#define COSPH_INSTANTIATE(D)                                                                \
+  template Vec<D> to_vec<D>(const google::protobuf::RepeatedField<double>&);                \
+  template ShapePtr<D> build_shape<D>(const proto::Shape&, const std::string&);             \
+  template ParticleCloud<D> build_body<D>(const proto::BodySpec&, const std::string&,       \
+                                          const std::string&);                              \
+  template Domain<D> build_domain<D>(const proto::Scene&);                                  \
+  template void check_inside_domain<D>(const proto::Scene&, const ParticleCloud<D>&,        \
+                                       const std::string&);                                 \
+  template void build_static_body<D>(const proto::Scene&, const proto::BodySpec&,           \
+                                     const std::string&, const std::string&, const Kernel&, \
+                                     ParticleSet<D>&);
 COSPH_INSTANTIATE(2)
 COSPH_INSTANTIATE(3)
 

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "core/particles.hpp"
 #include "geometry/particle_cloud.hpp"
 #include "geometry/shapes.hpp"
 #include "kernels/kernel.hpp"
@@ -32,5 +33,13 @@ Kernel build_kernel(const proto::BodySpec& body, int dimension);
 template <int D>
 void check_inside_domain(const proto::Scene& scene, const ParticleCloud<D>& cloud,
                          const std::string& key_path);
+
+// Particles that never move (diffusion, monodomain): the body's cloud checked against the domain,
+// sorted by cell once for memory locality, wrapped into periodic axes, with the fields "position"
+// and "volume" registered (output) in `particles`.
+template <int D>
+void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
+                       const std::string& key_path, const std::string& scene_directory,
+                       const Kernel& kernel, ParticleSet<D>& particles);
 
 }  // namespace cosph

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -102,6 +103,39 @@ void apply_diffusion(const NeighbourList& neighbours, const std::vector<double>&
     rate[i] = sum;
   });
 }
+
+template <int D>
+void ExplicitDiffusion<D>::setup(const std::vector<Vec<D>>& positions,
+                                 const std::vector<double>& volumes,
+                                 const NeighbourList& neighbours, const Kernel& kernel,
+                                 const Domain<D>& domain,
+                                 const std::vector<Mat<D>>& diffusion_tensor, bool corrected,
+                                 double time_step_factor) {
+  neighbours_ = &neighbours;
+  weights_ = diffusion_pair_weights<D>(positions, volumes, neighbours, kernel, domain,
+                                       diffusion_tensor, corrected);
+  double max_trace = 0.0;
+  for (const auto& t : diffusion_tensor) max_trace = std::max(max_trace, t.trace());
+  const double h = kernel.smoothing_length();
+  const double paper = time_step_factor * h * h / (D * max_trace);
+  double row_max = 0.0;
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    double row = 0.0;
+    for (std::size_t k = neighbours.offset[i]; k < neighbours.offset[i + 1]; ++k)
+      row += weights_[k];
+    row_max = std::max(row_max, row);
+  }
+  stable_dt_ = row_max > 0.0 ? std::min(paper, 1.0 / row_max) : paper;
+}
+
+template <int D>
+void ExplicitDiffusion<D>::step(std::vector<double>& c, double dt) {
+  apply_diffusion(*neighbours_, weights_, c, rate_);
+  parallel_for_each_index(c.size(), [&](std::size_t i) { c[i] += dt * rate_[i]; });
+}
+
+template class ExplicitDiffusion<2>;
+template class ExplicitDiffusion<3>;
 
 #define COSPH_INSTANTIATE(D)                                                                       \
   template double anisotropic_pair_factor<D>(const Mat<D>&, double, const Vec<D>&);                \

@@ -56,3 +56,33 @@ void apply_diffusion(const NeighbourList& neighbours, const std::vector<double>&
                      const std::vector<double>& c, std::vector<double>& rate);
 
 }  // namespace cosph
+
+namespace cosph {
+
+// Explicit (forward Euler) diffusion on fixed particles: precomputed pair weights, the stable step
+// and the update c += dt * L c. Shared by the diffusion and monodomain modules.
+template <int D>
+class ExplicitDiffusion {
+ public:
+  // `time_step_factor`: dt = factor * h^2 / (d max tr D) (seed 001), capped by the Gershgorin
+  // bound 1 / max_i sum_j w_ij of the assembled operator, which guarantees stability (and the
+  // discrete maximum principle, the weights being positive) even where the kernel correction
+  // enlarges weights near boundaries.
+  void setup(const std::vector<Vec<D>>& positions, const std::vector<double>& volumes,
+             const NeighbourList& neighbours, const Kernel& kernel, const Domain<D>& domain,
+             const std::vector<Mat<D>>& diffusion_tensor, bool corrected, double time_step_factor);
+
+  double stable_dt() const { return stable_dt_; }
+  // c_i += dt * sum_j w_ij (c_j - c_i).
+  void step(std::vector<double>& c, double dt);
+
+ private:
+  const NeighbourList* neighbours_ = nullptr;
+  std::vector<double> weights_, rate_;
+  double stable_dt_ = 0.0;
+};
+
+extern template class ExplicitDiffusion<2>;
+extern template class ExplicitDiffusion<3>;
+
+}  // namespace cosph

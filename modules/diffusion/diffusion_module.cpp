@@ -7,11 +7,11 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
-#include "operators/diffusion_operator.hpp"
 #include "driver/scene_geometry.hpp"
 #include "expression/expression.hpp"
 #include "geometry/regions.hpp"
 #include "neighbour/cell_linked_list.hpp"
+#include "operators/diffusion_operator.hpp"
 
 namespace cosph {
 namespace {
@@ -61,21 +61,12 @@ class DiffusionModule final : public Module {
     if (has_iso == has_aniso) throw ConfigError(key_, "give either diffusivity or anisotropy");
     const Mat<D> tensor = diffusion_tensor();
 
-    auto cloud = build_body<D>(spec_.body(), key_ + ".body", scene_directory_);
-    check_inside_domain<D>(scene_, cloud, key_ + ".body");
-    // Sort by cell once: the particles never move, and neighbours adjacent in memory make the
-    // pair loop cache-friendly.
-    auto order = cell_sort_order<D>(cloud.positions, kernel_.support_radius(), domain_);
-    particles_.resize(cloud.positions.size());
-    auto& x = particles_.add_vector("position", {.output = true});
-    auto& V = particles_.add_scalar("volume", {.output = true});
+    build_static_body<D>(scene_, spec_.body(), key_ + ".body", scene_directory_, kernel_,
+                         particles_);
+    const auto& x = particles_.vector("position");
+    const auto& V = particles_.scalar("volume");
     auto& c = particles_.add_scalar(spec_.field(),
                                     {.output = true, .checkpoint = true, .exchange = true});
-    for (std::size_t k = 0; k < order.size(); ++k) {
-      x[k] = domain_.any_periodic() ? domain_.wrap(cloud.positions[order[k]])
-                                    : cloud.positions[order[k]];
-      V[k] = cloud.volumes[order[k]];
-    }
 
     const Expression initial =
         parse_expression(spec_.initial(), kSpaceTimeVariables, key_ + ".initial");
@@ -99,26 +90,12 @@ class DiffusionModule final : public Module {
     neighbours_ = build_inner_list<D>(x, kernel_.support_radius(), domain_);
     const std::vector<Mat<D>> tensors(x.size(), tensor);
     try {
-      weights_ = diffusion_pair_weights<D>(x, V, neighbours_, kernel_, domain_, tensors,
-                                           spec_.kernel_correction());
+      diffusion_.setup(x, V, neighbours_, kernel_, domain_, tensors, spec_.kernel_correction(),
+                       spec_.time_step_factor());
     } catch (const RuntimeError& e) {
       throw RuntimeError("module '" + name_ + "': " + e.what());
     }
-
-    // Seed 001: dt = 0.5 h^2 / (d tr D). The explicit Euler step is also kept below the
-    // Gershgorin bound 1 / max_i sum_j w_ij of the assembled operator, which guarantees
-    // stability even where the kernel correction enlarges weights near boundaries.
-    const double h = kernel_.smoothing_length();
-    const double paper = spec_.time_step_factor() * h * h / (D * tensor.trace());
-    double row_max = 0.0;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      double row = 0.0;
-      for (std::size_t k = neighbours_.offset[i]; k < neighbours_.offset[i + 1]; ++k)
-        row += weights_[k];
-      row_max = std::max(row_max, row);
-    }
-    max_dt_ = row_max > 0.0 ? std::min(paper, 1.0 / row_max) : paper;
-    if (spec_.has_time_step()) max_dt_ = spec_.time_step();
+    max_dt_ = spec_.has_time_step() ? spec_.time_step() : diffusion_.stable_dt();
 
     // Bounds for the health check: with positive weights and dt * sum_j w_ij <= 1 each step is a
     // convex combination, so c stays within the range of its initial and boundary values
@@ -151,9 +128,7 @@ class DiffusionModule final : public Module {
   double time() const override { return time_; }
 
   void advance(double dt) override {
-    auto& c = particles_.scalar(spec_.field());
-    apply_diffusion(neighbours_, weights_, c, rate_);
-    parallel_for_each_index(c.size(), [&](std::size_t i) { c[i] += dt * rate_[i]; });
+    diffusion_.step(particles_.scalar(spec_.field()), dt);
     time_ += dt;
     ++steps_;
     apply_fixed_values();
@@ -262,7 +237,7 @@ class DiffusionModule final : public Module {
   Kernel kernel_;
   Domain<D> domain_;
   NeighbourList neighbours_;
-  std::vector<double> weights_, rate_;
+  ExplicitDiffusion<D> diffusion_;
   std::vector<Fixed> fixed_;
   double max_dt_ = 0.0, time_ = 0.0;
   double lower_ = INFINITY, upper_ = -INFINITY, initial_energy_ = 0.0;

@@ -1,0 +1,983 @@
+#!/usr/bin/python3
+"""Accuracy-versus-cost studies: runs one cosph scene over a sweep of overrides, compares a probe
+quantity of every run with a reference, and writes results.csv, table.md and plot.png.
+
+usage: bench/study.py STUDY.yaml [--cosph PATH] [--out DIR] [--repeat N] [--expect-max-error X]
+
+A study file (YAML; see bench/studies/*.yaml and the README section "Accuracy-versus-cost
+studies") names the scene, the sweep, the quantity, the reference with its source, and the norm.
+Exit codes: 0 done (points may have failed: they are recorded, not dropped), 1 the outputs could
+not be written or the best error exceeds --expect-max-error, 2 an invalid study file or usage.
+"""
+import argparse
+import ast
+import csv
+import itertools
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+import matplotlib
+import numpy as np
+import yaml
+
+matplotlib.use("Agg")  # files only: the tool runs headless in CI
+import matplotlib.pyplot as plt  # noqa: E402
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_COSPH = REPO_ROOT / "build" / "release" / "app" / "cosph"
+
+KINDS = ("profile", "time_series", "final")
+# Which quantity kinds each norm makes sense for: a spatial L2 needs a profile, an arrival time
+# needs a time series, a relative error at a point needs a single value.
+NORM_KINDS = {
+    "max": ("profile", "time_series", "final"),
+    "l2_relative": ("profile",),
+    "l2_time": ("time_series",),
+    "relative_at_point": ("final",),
+    "arrival_time": ("time_series",),
+}
+NORM_TEXT = {
+    "max": "maximum absolute error",
+    "l2_relative": "relative L2 error over the probe points, sqrt(sum (s - r)^2 / sum r^2)",
+    "l2_time": "relative L2 error over the time series, sqrt(sum (s - r)^2 / sum r^2)",
+    "relative_at_point": "relative error of the final value, |s - r| / |r|",
+    "arrival_time": "absolute error of the arrival time (first upward crossing of the threshold)",
+}
+VARIABLES = ("x", "y", "z", "t", "distance")
+CSV_ALONG = ("time", "x", "y", "z", "distance")
+
+
+class StudyError(Exception):
+    """An invalid study file: the message names the file and the key."""
+
+
+class ComparisonError(Exception):
+    """A run that finished but whose output cannot be compared with the reference."""
+
+
+# ---- Study file -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Axis:
+    key: str
+    values: list
+    label: str
+
+
+@dataclass(frozen=True)
+class Point:
+    index: int
+    label: str
+    overrides: dict  # scene key path -> value, in --set order
+    axis_values: dict  # axis label -> value (empty for explicit points)
+
+
+@dataclass(frozen=True)
+class Quantity:
+    probe: str
+    kind: str
+    field: Optional[str]
+    column: Optional[str]
+    time: Any  # "last" or a simulated time (profile only)
+
+
+@dataclass(frozen=True)
+class Reference:
+    kind: str  # expression, csv or value
+    source: str
+    expression: Optional[str] = None
+    definitions: tuple = ()  # ((name, text, code), ...) evaluated in order before the expression
+    code: Any = None
+    csv_file: Optional[Path] = None
+    abscissa: Optional[np.ndarray] = None
+    ordinate: Optional[np.ndarray] = None
+    along: str = "time"
+    value: Optional[float] = None
+
+
+@dataclass(frozen=True)
+class Study:
+    path: Path
+    name: str
+    title: str
+    description: str
+    scene: Path
+    overrides: dict
+    axes: list
+    explicit_points: list
+    quantity: Quantity
+    reference: Reference
+    norm: str
+    threshold: Optional[float]
+    repeat: int
+    order: Optional[int]
+
+    def points(self) -> list:
+        """The cartesian product of the axes, then the explicit points."""
+        points = []
+        # product() of no axes would yield one empty point: a study of explicit points only
+        # must not get an extra point without overrides.
+        combos = itertools.product(*(axis.values for axis in self.axes)) if self.axes else []
+        for combo in combos:
+            overrides = dict(self.overrides)
+            axis_values = {}
+            for axis, value in zip(self.axes, combo):
+                overrides[axis.key] = value
+                axis_values[axis.label] = value
+            label = ", ".join(f"{a}={format_value(v)}" for a, v in axis_values.items())
+            points.append(Point(len(points), label, overrides, axis_values))
+        for label, extra in self.explicit_points:
+            points.append(Point(len(points), label, {**self.overrides, **extra}, {}))
+        return points
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """A safe loader that rejects duplicate keys (PyYAML would silently keep the last one)."""
+
+
+def _construct_unique_mapping(loader, node, deep=False):
+    seen = set()
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            mark = key_node.start_mark
+            raise yaml.constructor.ConstructorError(
+                None, None, f"duplicate key '{key}' (line {mark.line + 1})", mark)
+        seen.add(key)
+    return loader.construct_mapping(node, deep)
+
+
+_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
+                                 _construct_unique_mapping)
+
+
+def _check_keys(node: Any, where: str, required: tuple, optional: tuple = ()) -> dict:
+    if not isinstance(node, dict):
+        raise StudyError(f"{where}: expected a mapping, got {type(node).__name__}")
+    allowed = required + optional
+    for key in node:
+        if key not in allowed:
+            raise StudyError(f"{where}.{key}: unknown key '{key}'; expected one of: "
+                             + ", ".join(allowed))
+    for key in required:
+        if node.get(key) is None:
+            raise StudyError(f"{where}.{key}: missing (required)")
+    return node
+
+
+def _string(node: Any, where: str) -> str:
+    if not isinstance(node, str) or not node.strip():
+        raise StudyError(f"{where}: expected a non-empty string")
+    return node.strip()
+
+
+def _number(node: Any, where: str) -> float:
+    if isinstance(node, bool) or not isinstance(node, (int, float)):
+        raise StudyError(f"{where}: expected a number, got {node!r}")
+    return float(node)
+
+
+def _overrides(node: Any, where: str) -> dict:
+    if node is None:
+        return {}
+    if not isinstance(node, dict):
+        raise StudyError(f"{where}: expected a mapping of scene key paths to values")
+    for key, value in node.items():
+        if not isinstance(key, str) or value is None:
+            raise StudyError(f"{where}.{key}: expected 'scene.key.path: value'")
+    return dict(node)
+
+
+def load_study(path: Path) -> Study:
+    """Reads and validates a study file; raises StudyError naming the offending key."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise StudyError(f"{path}: cannot read: {error.strerror}") from None
+    try:
+        root = yaml.load(text, Loader=_UniqueKeyLoader)
+    except yaml.YAMLError as error:
+        raise StudyError(f"{path}: not valid YAML: {error}") from None
+    try:
+        return _parse_study(path, root)
+    except StudyError as error:
+        raise StudyError(f"{path}: {error}") from None
+
+
+def _parse_study(path: Path, root: Any) -> Study:
+    _check_keys(root, "study", ("title", "description", "scene", "sweep", "quantity",
+                                "reference", "norm"),
+                ("name", "overrides", "threshold", "repeat", "order"))
+    scene = (path.parent / _string(root["scene"], "scene")).resolve()
+    if not scene.is_file():
+        raise StudyError(f"scene: no such file: {scene}")
+    axes, explicit = _parse_sweep(root["sweep"])
+    quantity = _parse_quantity(root["quantity"], scene)
+    norm = root["norm"]
+    if norm not in NORM_KINDS:
+        raise StudyError(f"norm: unknown norm {norm!r}; expected one of: " + ", ".join(NORM_KINDS))
+    if quantity.kind not in NORM_KINDS[norm]:
+        raise StudyError(f"norm: '{norm}' does not apply to a quantity of kind '{quantity.kind}' "
+                         f"(it applies to: {', '.join(NORM_KINDS[norm])})")
+    threshold = root.get("threshold")
+    if norm == "arrival_time":
+        if threshold is None:
+            raise StudyError("threshold: missing (required by norm arrival_time)")
+        threshold = _number(threshold, "threshold")
+    elif threshold is not None:
+        raise StudyError("threshold: only used with norm arrival_time")
+    reference = _parse_reference(root["reference"], path.parent, quantity, norm)
+    repeat = root.get("repeat", 1)
+    if not isinstance(repeat, int) or isinstance(repeat, bool) or repeat < 1:
+        raise StudyError(f"repeat: expected an integer >= 1, got {repeat!r}")
+    order = root.get("order")
+    if order is not None and (not isinstance(order, int) or isinstance(order, bool)):
+        raise StudyError(f"order: expected an integer, got {order!r}")
+    return Study(path=path.resolve(), name=_string(root.get("name", path.stem), "name"),
+                 title=_string(root["title"], "title"),
+                 description=_string(root["description"], "description"), scene=scene,
+                 overrides=_overrides(root.get("overrides"), "overrides"), axes=axes,
+                 explicit_points=explicit, quantity=quantity, reference=reference, norm=norm,
+                 threshold=threshold, repeat=repeat, order=order)
+
+
+def _parse_sweep(node: Any) -> tuple:
+    _check_keys(node, "sweep", (), ("axes", "points"))
+    axes, explicit = [], []
+    for i, axis in enumerate(node.get("axes") or []):
+        where = f"sweep.axes[{i}]"
+        _check_keys(axis, where, ("key", "values"), ("label",))
+        key = _string(axis["key"], f"{where}.key")
+        values = axis["values"]
+        if not isinstance(values, list) or not values:
+            raise StudyError(f"{where}.values: expected a non-empty list")
+        label = _string(axis.get("label", key.rsplit(".", 1)[-1]), f"{where}.label")
+        axes.append(Axis(key, values, label))
+    for i, point in enumerate(node.get("points") or []):
+        where = f"sweep.points[{i}]"
+        _check_keys(point, where, ("label", "overrides"))
+        explicit.append((_string(point["label"], f"{where}.label"),
+                         _overrides(point["overrides"], f"{where}.overrides")))
+    if not axes and not explicit:
+        raise StudyError("sweep: needs 'axes' or 'points' (or both)")
+    labels = [axis.label for axis in axes]
+    if len(set(labels)) != len(labels):
+        raise StudyError("sweep.axes: two axes share a label; give them distinct 'label's")
+    return axes, explicit
+
+
+def _scene_probes(scene: Path) -> dict:
+    """The scene's probes by name, so that a misspelt probe is caught before anything runs."""
+    try:
+        root = yaml.safe_load(scene.read_text()) or {}
+    except (OSError, yaml.YAMLError) as error:
+        raise StudyError(f"scene: cannot read {scene}: {error}") from None
+    probes = (root.get("probes") or []) if isinstance(root, dict) else []
+    return {p.get("name"): p for p in probes if isinstance(p, dict)}
+
+
+def _parse_quantity(node: Any, scene: Path) -> Quantity:
+    _check_keys(node, "quantity", ("probe", "kind"), ("field", "column", "time"))
+    probe = _string(node["probe"], "quantity.probe")
+    kind = node["kind"]
+    if kind not in KINDS:
+        raise StudyError(f"quantity.kind: unknown kind {kind!r}; expected one of: "
+                         + ", ".join(KINDS))
+    probes = _scene_probes(scene)
+    if probe not in probes:
+        raise StudyError(f"quantity.probe: the scene has no probe '{probe}' (it has: "
+                         + ", ".join(str(name) for name in probes) + ")")
+    spec = probes[probe]
+    if kind == "profile":
+        if "line" not in spec and "points" not in spec:
+            raise StudyError(f"quantity.kind: a profile needs a line or points probe; "
+                             f"'{probe}' is neither")
+        if node.get("column") is not None:
+            raise StudyError("quantity.column: not used by a profile (it takes every column "
+                             "of 'field')")
+    else:
+        if node.get("column") is None:
+            raise StudyError(f"quantity.column: missing (required by kind {kind}), e.g. "
+                             "concentration@p0")
+        if node.get("time") is not None:
+            raise StudyError("quantity.time: only used by a profile")
+    when = node.get("time", "last")
+    if when != "last":
+        when = _number(when, "quantity.time")
+    field_name = node.get("field")
+    if field_name is not None:
+        field_name = _string(field_name, "quantity.field")
+    column = node.get("column")
+    if column is not None:
+        column = _string(column, "quantity.column")
+    return Quantity(probe, kind, field_name, column, when)
+
+
+def _parse_reference(node: Any, base: Path, quantity: Quantity, norm: str) -> Reference:
+    if not isinstance(node, dict):
+        raise StudyError("reference: expected a mapping")
+    if node.get("source") is None:
+        raise StudyError("reference.source: missing (required: where the reference comes from)")
+    source = _string(node["source"], "reference.source")
+    given = [kind for kind in ("expression", "csv", "value") if node.get(kind) is not None]
+    if len(given) != 1:
+        raise StudyError("reference: give exactly one of 'expression', 'csv', 'value'")
+    kind = given[0]
+    if kind == "expression":
+        _check_keys(node, "reference", ("source", "expression"), ("definitions",))
+        definitions = _compile_definitions(node.get("definitions"))
+        known = set(VARIABLES) | {name for name, _, _ in definitions}
+        text = _string(node["expression"], "reference.expression")
+        code = compile_expression(text, "reference.expression", known)
+        return Reference(kind, source, expression=text, definitions=definitions, code=code)
+    if kind == "value":
+        _check_keys(node, "reference", ("source", "value"))
+        return Reference(kind, source, value=_number(node["value"], "reference.value"))
+    _check_keys(node, "reference", ("source", "csv", "columns"), ("along",))
+    along = node.get("along", "time")
+    if along not in CSV_ALONG:
+        raise StudyError(f"reference.along: expected one of: {', '.join(CSV_ALONG)}")
+    if norm == "arrival_time" and along != "time":
+        raise StudyError("reference.along: an arrival time needs a reference along time")
+    columns = node["columns"]
+    if not isinstance(columns, list) or len(columns) != 2:
+        raise StudyError("reference.columns: expected [abscissa column, value column]")
+    csv_file = (base / _string(node["csv"], "reference.csv")).resolve()
+    abscissa, ordinate = read_reference_csv(csv_file, columns)
+    return Reference(kind, source, csv_file=csv_file, abscissa=abscissa, ordinate=ordinate,
+                     along=along)
+
+
+def _compile_definitions(node: Any) -> tuple:
+    if node is None:
+        return ()
+    if not isinstance(node, dict):
+        raise StudyError("reference.definitions: expected a mapping 'name: expression'")
+    known = set(VARIABLES)
+    compiled = []
+    for name, text in node.items():
+        where = f"reference.definitions.{name}"
+        if not isinstance(name, str) or not name.isidentifier():
+            raise StudyError(f"{where}: not a valid name")
+        if name in VARIABLES or name in expression_functions():
+            raise StudyError(f"{where}: '{name}' is a variable or function name already")
+        text = str(text) if isinstance(text, (int, float)) else _string(text, where)
+        compiled.append((name, text, compile_expression(text, where, known)))
+        known.add(name)
+    return tuple(compiled)
+
+
+def read_reference_csv(path: Path, columns: list) -> tuple:
+    """Two columns of a CSV file ('#' comment lines, one header line), sorted by the first."""
+    try:
+        lines = [line for line in path.read_text().splitlines()
+                 if line.strip() and not line.lstrip().startswith("#")]
+    except OSError as error:
+        raise StudyError(f"reference.csv: cannot read {path}: {error.strerror}") from None
+    rows = list(csv.reader(lines))
+    if len(rows) < 3:
+        raise StudyError(f"reference.csv: {path} needs a header line and at least two rows")
+    header = [name.strip() for name in rows[0]]
+    indices = []
+    for column in columns:
+        if isinstance(column, int) and not isinstance(column, bool) and 0 <= column < len(header):
+            indices.append(column)
+        elif column in header:
+            indices.append(header.index(column))
+        else:
+            raise StudyError(f"reference.columns: no column {column!r} in {path} "
+                             f"(header: {', '.join(header)})")
+    try:
+        data = np.array([[float(row[i]) for i in indices] for row in rows[1:]])
+    except (ValueError, IndexError):
+        raise StudyError(f"reference.csv: {path}: non-numeric or missing values in columns "
+                         f"{columns}") from None
+    data = data[np.argsort(data[:, 0], kind="stable")]
+    return data[:, 0], data[:, 1]
+
+
+# ---- Reference expressions --------------------------------------------------------------------
+
+def _heaviside(value, at_zero=1.0):
+    return np.heaviside(value, at_zero)
+
+
+def expression_functions() -> dict:
+    """The whole namespace an expression may use, besides x, y, z, t, distance and definitions."""
+    erf = np.vectorize(math.erf, otypes=[float])
+    erfc = np.vectorize(math.erfc, otypes=[float])
+    return {
+        "pi": math.pi, "e": math.e, "inf": math.inf,
+        "erf": erf, "erfc": erfc, "exp": np.exp, "log": np.log, "log10": np.log10,
+        "sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin,
+        "acos": np.arccos, "atan": np.arctan, "atan2": np.arctan2, "sinh": np.sinh,
+        "cosh": np.cosh, "tanh": np.tanh, "abs": np.abs, "sign": np.sign, "floor": np.floor,
+        "ceil": np.ceil, "minimum": np.minimum, "maximum": np.maximum, "where": np.where,
+        "hypot": np.hypot, "heaviside": _heaviside,
+    }
+
+
+# Only arithmetic, comparisons, numbers, names and calls of the namespace's functions: no
+# attributes, subscripts or literals of other types, so eval() cannot reach anything else.
+_ALLOWED_NODES = (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Call, ast.Name, ast.Load,
+                  ast.Constant, ast.Compare, ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow,
+                  ast.Mod, ast.USub, ast.UAdd, ast.Lt, ast.LtE, ast.Gt, ast.GtE, ast.Eq,
+                  ast.NotEq)
+
+
+def compile_expression(text: str, where: str, known: set) -> Any:
+    """Compiles a reference expression after checking it uses only the restricted namespace."""
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError as error:
+        raise StudyError(f"{where}: syntax error in {text.strip()!r}: {error.msg}") from None
+    functions = expression_functions()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.BitXor):
+            raise StudyError(f"{where}: '^' is not a power here; write a**b")
+        if not isinstance(node, _ALLOWED_NODES):
+            raise StudyError(f"{where}: '{type(node).__name__}' is not allowed in an expression")
+        if isinstance(node, ast.Constant) and not isinstance(node.value, (int, float)):
+            raise StudyError(f"{where}: only numbers may appear as constants")
+        if isinstance(node, ast.Call) and (not isinstance(node.func, ast.Name)
+                                           or node.func.id not in functions or node.keywords):
+            name = node.func.id if isinstance(node.func, ast.Name) else "this call"
+            raise StudyError(f"{where}: unknown function '{name}'; known functions: "
+                             + ", ".join(sorted(k for k, v in functions.items() if callable(v)))
+                             + " (positional arguments only)")
+        if isinstance(node, ast.Name) and node.id not in known and node.id not in functions:
+            raise StudyError(f"{where}: unknown name '{node.id}' (variables: "
+                             + ", ".join(sorted(known)) + ")")
+    return compile(tree, where, "eval")
+
+
+def evaluate_reference(reference: Reference, variables: dict) -> np.ndarray:
+    """The reference at the sample's x, y, z, t, distance (arrays of one shape)."""
+    shape = np.shape(variables["t"])
+    if reference.kind == "value":
+        return np.full(shape, reference.value)
+    if reference.kind == "csv":
+        where = np.asarray(variables[reference.along], dtype=float)
+        # Outside the reference's range there is nothing to compare with: NaN, excluded later.
+        return np.interp(where, reference.abscissa, reference.ordinate, left=np.nan,
+                         right=np.nan)
+    namespace = dict(expression_functions())
+    namespace.update({name: np.asarray(value, dtype=float) for name, value in variables.items()})
+    with np.errstate(all="ignore"):
+        for name, _, code in reference.definitions:
+            namespace[name] = eval(code, {"__builtins__": {}}, namespace)  # noqa: S307
+        result = eval(reference.code, {"__builtins__": {}}, namespace)  # noqa: S307
+    return np.broadcast_to(np.asarray(result, dtype=float), shape).copy()
+
+
+# ---- Running points ---------------------------------------------------------------------------
+
+@dataclass
+class Sample:
+    """The simulated quantity of one point, with where (and when) each value was taken."""
+    values: np.ndarray
+    variables: dict  # x, y, z, t, distance: arrays shaped like values
+    abscissa: np.ndarray  # for plots: the coordinate along the profile, or time
+    abscissa_name: str
+    field_name: str
+
+
+@dataclass
+class PointResult:
+    point: Point
+    status: str = "ok"  # ok, failed or diverged
+    message: str = ""
+    error: float = math.nan
+    wall_seconds: float = math.nan
+    cpu_seconds: float = math.nan
+    particles: float = math.nan
+    steps: float = math.nan
+    particle_steps_per_second: float = math.nan
+    threads: float = math.nan
+    sample: Optional[Sample] = None
+    reference_values: Optional[np.ndarray] = None
+    arrivals: Optional[tuple] = None  # (simulated, reference) arrival times
+
+
+def format_value(value: Any) -> str:
+    """A scene value as --set and labels want it (YAML spelling: true/false, [a, b])."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:g}" if float(f"{value:g}") == value else repr(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(format_value(v) for v in value) + "]"
+    return str(value)
+
+
+def cosph_command(cosph: Path, scene: Path, overrides: dict, out_dir: Path,
+                  action: str = "run") -> list:
+    command = [str(cosph), action, str(scene)]
+    for key, value in overrides.items():
+        command += ["--set", f"{key}={format_value(value)}"]
+    if action == "run":
+        command += ["--output", str(out_dir), "--quiet"]
+    return command
+
+
+def check_first_point(study: Study, cosph: Path) -> None:
+    """Validates the scene with the first point's overrides (`cosph check`), so that a misspelt
+    sweep key stops the study at once instead of failing every point."""
+    point = study.points()[0]
+    command = cosph_command(cosph, study.scene, point.overrides, Path("."), action="check")
+    done = subprocess.run(command, capture_output=True, text=True, check=False)
+    if done.returncode == 2:
+        raise StudyError(f"{study.path}: the scene rejects the overrides of point "
+                         f"'{point.label}': {first_line(done.stderr)}")
+
+
+def first_line(text: str) -> str:
+    for line in text.splitlines():
+        if line.strip():
+            return line.strip()
+    return ""
+
+
+def run_point(study: Study, point: Point, cosph: Path, out_dir: Path, repeat: int,
+              timeout: float) -> PointResult:
+    """Runs one point (the fastest of `repeat` runs counts) and compares it with the reference."""
+    result = PointResult(point)
+    best_summary = None
+    for _ in range(repeat):
+        if out_dir.exists():
+            shutil.rmtree(out_dir)
+        command = cosph_command(cosph, study.scene, point.overrides, out_dir)
+        try:
+            done = subprocess.run(command, capture_output=True, text=True, timeout=timeout,
+                                  check=False)
+        except subprocess.TimeoutExpired:
+            result.status, result.message = "failed", f"timed out after {timeout:g} s"
+            return result
+        out_dir.mkdir(parents=True, exist_ok=True)
+        (out_dir / "cosph.log").write_text(f"$ {' '.join(command)}\n{done.stdout}{done.stderr}")
+        if done.returncode != 0:
+            diverged = "health check failed" in done.stderr
+            result.status = "diverged" if diverged else "failed"
+            result.message = first_line(done.stderr) or f"exit code {done.returncode}"
+            return result
+        try:
+            summary = json.loads((out_dir / "summary.json").read_text())
+        except (OSError, ValueError) as error:
+            result.status, result.message = "failed", f"summary.json: {error}"
+            return result
+        if best_summary is None or summary["wall_seconds"] < best_summary["wall_seconds"]:
+            best_summary = summary
+    for name in ("wall_seconds", "cpu_seconds", "particles", "steps",
+                 "particle_steps_per_second", "threads"):
+        setattr(result, name, float(best_summary.get(name, math.nan)))
+    try:
+        compare(study, out_dir, result)
+    except ComparisonError as error:
+        result.status, result.message = "failed", f"comparison: {error}"
+    return result
+
+
+# ---- Probes and comparison --------------------------------------------------------------------
+
+def read_probe(out_dir: Path, probe: str) -> tuple:
+    """(times, column names, values[row, column], {label: (x, y, z)}) of a probe's CSV files."""
+    path = out_dir / f"{probe}.csv"
+    try:
+        with open(path, newline="") as stream:
+            rows = list(csv.reader(stream))
+    except OSError:
+        raise ComparisonError(f"no probe file {path.name}") from None
+    if len(rows) < 2 or rows[0][0] != "time":
+        raise ComparisonError(f"{path.name} has no data rows")
+    data = np.array([[float(cell) for cell in row] for row in rows[1:] if row])
+    coordinates = {}
+    points_path = out_dir / f"{probe}.points.csv"
+    if points_path.exists():
+        with open(points_path, newline="") as stream:
+            for row in list(csv.reader(stream))[1:]:
+                if row:
+                    xyz = [float(v) for v in row[1:]] + [0.0] * (4 - len(row))
+                    coordinates[row[0]] = tuple(xyz[:3])
+    return data[:, 0], rows[0][1:], data[:, 1:], coordinates
+
+
+def _field_of(column: str) -> str:
+    return column.split("@", 1)[0]
+
+
+def extract_sample(quantity: Quantity, out_dir: Path) -> Sample:
+    times, columns, values, coordinates = read_probe(out_dir, quantity.probe)
+    if quantity.kind == "profile":
+        return _profile_sample(quantity, times, columns, values, coordinates)
+    if quantity.column not in columns:
+        raise ComparisonError(f"probe '{quantity.probe}' has no column '{quantity.column}' "
+                              f"(it has {', '.join(columns[:6])}{', ...' if len(columns) > 6 else ''})")
+    series = values[:, columns.index(quantity.column)]
+    label = quantity.column.split("@", 1)[1] if "@" in quantity.column else None
+    origin = next(iter(coordinates.values()), None)
+    xyz = coordinates.get(label, (math.nan,) * 3)
+    distance = math.dist(xyz, origin) if origin and label in coordinates else math.nan
+    if quantity.kind == "final":
+        times, series = times[-1:], series[-1:]
+    variables = {"x": np.full_like(times, xyz[0]), "y": np.full_like(times, xyz[1]),
+                 "z": np.full_like(times, xyz[2]), "t": times,
+                 "distance": np.full_like(times, distance)}
+    return Sample(series, variables, times, "time", _field_of(quantity.column))
+
+
+def _profile_sample(quantity: Quantity, times, columns, values, coordinates) -> Sample:
+    fields = sorted({_field_of(c) for c in columns})
+    name = quantity.field or (fields[0] if len(fields) == 1 else None)
+    if name is None or name not in fields:
+        raise ComparisonError(f"quantity.field: choose one of {', '.join(fields)}")
+    chosen = [i for i, c in enumerate(columns) if _field_of(c) == name]
+    labels = [columns[i].split("@", 1)[1] for i in chosen]
+    missing = [label for label in labels if label not in coordinates]
+    if missing:
+        raise ComparisonError(f"no coordinates for {missing[0]} in {quantity.probe}.points.csv")
+    row = len(times) - 1 if quantity.time == "last" else int(np.argmin(abs(times - quantity.time)))
+    xyz = np.array([coordinates[label] for label in labels])
+    distance = np.linalg.norm(xyz - xyz[0], axis=1)
+    variables = {"x": xyz[:, 0], "y": xyz[:, 1], "z": xyz[:, 2],
+                 "t": np.full(len(labels), times[row]), "distance": distance}
+    # Plot against the one coordinate that varies along the probe, else the distance along it.
+    varying = [axis for i, axis in enumerate("xyz") if np.ptp(xyz[:, i]) > 0]
+    axis = varying[0] if len(varying) == 1 else "distance"
+    return Sample(values[row, chosen], variables, variables[axis], axis, name)
+
+
+def arrival_time(times: np.ndarray, values: np.ndarray, threshold: float) -> float:
+    """First upward crossing of the threshold, linear between rows; NaN when there is none."""
+    below = values[:-1] < threshold
+    reaches = values[1:] >= threshold
+    crossings = np.nonzero(below & reaches)[0]
+    if len(crossings) == 0:
+        return math.nan
+    i = crossings[0]
+    t0, t1, v0, v1 = times[i], times[i + 1], values[i], values[i + 1]
+    return float(t0 + (threshold - v0) * (t1 - t0) / (v1 - v0))
+
+
+def _reference_arrival(study: Study, sample: Sample) -> float:
+    reference = study.reference
+    if reference.kind == "value":
+        return reference.value  # the reference arrival time itself
+    if reference.kind == "csv":
+        return arrival_time(reference.abscissa, reference.ordinate, study.threshold)
+    # An analytic reference is sampled much finer than the probe rows, so that its own
+    # arrival time carries no interpolation error.
+    t = np.linspace(sample.variables["t"][0], sample.variables["t"][-1], 4001)
+    fine = {name: np.full_like(t, values[0]) for name, values in sample.variables.items()}
+    fine["t"] = t
+    return arrival_time(t, evaluate_reference(reference, fine), study.threshold)
+
+
+def compare(study: Study, out_dir: Path, result: PointResult) -> None:
+    """Fills result.sample, reference_values and error."""
+    sample = extract_sample(study.quantity, out_dir)
+    reference = evaluate_reference(study.reference, sample.variables)
+    result.sample, result.reference_values = sample, reference
+    if study.norm == "arrival_time":
+        simulated = arrival_time(sample.abscissa, sample.values, study.threshold)
+        expected = _reference_arrival(study, sample)
+        result.arrivals = (simulated, expected)
+        if math.isnan(simulated):
+            raise ComparisonError(f"{study.quantity.column} never crosses {study.threshold:g}")
+        if math.isnan(expected):
+            raise ComparisonError(f"the reference never crosses {study.threshold:g}")
+        result.error = abs(simulated - expected)
+        return
+    usable = np.isfinite(reference)
+    if not usable.any():
+        raise ComparisonError("the reference is not finite at any sample")
+    s, r = sample.values[usable], reference[usable]
+    if study.norm == "max":
+        result.error = float(np.max(np.abs(s - r)))
+    elif study.norm in ("l2_relative", "l2_time"):
+        result.error = float(np.sqrt(np.sum((s - r) ** 2) / np.sum(r ** 2)))
+    elif study.norm == "relative_at_point":
+        result.error = float(abs(s[-1] - r[-1]) / abs(r[-1]))
+
+
+# ---- Outputs ----------------------------------------------------------------------------------
+
+RESULT_COLUMNS = ("wall_seconds", "cpu_seconds", "particles", "steps",
+                  "particle_steps_per_second", "threads")
+
+
+def write_results_csv(path: Path, study: Study, results: list) -> None:
+    axis_labels = [axis.label for axis in study.axes]
+    with open(path, "w", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow(["point", "label", *axis_labels, "overrides", "status", "message",
+                         "error", *RESULT_COLUMNS])
+        for r in results:
+            overrides = "; ".join(f"{k}={format_value(v)}" for k, v in r.point.overrides.items())
+            writer.writerow([r.point.index, r.point.label,
+                             *(format_value(r.point.axis_values.get(a, "")) for a in axis_labels),
+                             overrides, r.status, r.message, repr(r.error),
+                             *(repr(getattr(r, name)) for name in RESULT_COLUMNS)])
+
+
+def best_result(results: list) -> Optional[PointResult]:
+    usable = [r for r in results if r.status == "ok" and math.isfinite(r.error)]
+    return min(usable, key=lambda r: r.error) if usable else None
+
+
+def _cell(value: float, spec: str) -> str:
+    if not math.isfinite(value):
+        return "–"
+    return format(int(value), "d") if spec == "d" else format(value, spec)
+
+
+def markdown_table(results: list) -> str:
+    """The results as a Markdown table; the best point's error is bold."""
+    best = best_result(results)
+    lines = ["| point | particles | steps | error | wall s | particle-steps/s | status |",
+             "|---|---:|---:|---:|---:|---:|---|"]
+    for r in results:
+        error = _cell(r.error, ".3e")
+        if r is best:
+            error = f"**{error}**"
+        status = r.status if not r.message else f"{r.status}: {r.message}".replace("|", "\\|")
+        lines.append(f"| {r.point.label} | {_cell(r.particles, 'd')} | {_cell(r.steps, 'd')} | "
+                     f"{error} | {_cell(r.wall_seconds, '.3f')} | "
+                     f"{_cell(r.particle_steps_per_second, '.3g')} | {status} |")
+    return "\n".join(lines) + "\n"
+
+
+def write_table(path: Path, study: Study, results: list) -> None:
+    caption = (f"{study.title}: {NORM_TEXT[study.norm]} of `{study.quantity.probe}` "
+               f"({quantity_text(study.quantity)}) against the reference. Bold: lowest error.\n\n")
+    path.write_text(caption + markdown_table(results))
+
+
+def quantity_text(quantity: Quantity) -> str:
+    if quantity.kind == "profile":
+        when = "last row" if quantity.time == "last" else f"row nearest t = {quantity.time:g}"
+        return f"profile, {when}"
+    if quantity.kind == "time_series":
+        return f"time series of {quantity.column}"
+    return f"final value of {quantity.column}"
+
+
+def _plot_groups(study: Study, results: list) -> tuple:
+    """Groups of results for the error-cost panel, and the axis whose value labels each point.
+
+    With two axes the points are grouped by the axis that is not the resolution (the one whose
+    key names a spacing, else the first), so that each group is one convergence curve."""
+    if study.explicit_points or not study.axes:
+        return [("", results)], None
+    resolution = next((a for a in study.axes if a.key.endswith("spacing")), study.axes[0])
+    if len(study.axes) != 2:
+        return [("", results)], resolution if len(study.axes) == 1 else None
+    other = next(a for a in study.axes if a is not resolution)
+    groups = [(f"{other.label} = {format_value(value)}",
+               [r for r in results if r.point.axis_values[other.label] == value])
+              for value in other.values]
+    return groups, resolution
+
+
+def _plot_error_cost(ax, study: Study, results: list) -> None:
+    groups, label_axis = _plot_groups(study, results)
+    markers = "osD^v<>p"
+    # Points of different groups at one resolution sit close together: each group's labels go
+    # to another side of its points, in the group's colour, so that they overlap less.
+    placements = [((6, 3), "left", "bottom"), ((6, -3), "left", "top"),
+                  ((-6, 3), "right", "bottom"), ((-6, -3), "right", "top")]
+    plotted = 0
+    for g, (name, members) in enumerate(groups):
+        ok = [r for r in members if r.status == "ok" and math.isfinite(r.error)
+              and r.error > 0 and r.wall_seconds > 0]
+        if not ok:
+            continue
+        plotted += len(ok)
+        wall = [r.wall_seconds for r in ok]
+        error = [r.error for r in ok]
+        (line,) = ax.plot(wall, error, marker=markers[g % len(markers)], ms=6, lw=1.2,
+                          label=name or None, alpha=0.9)
+        offset, ha, va = placements[g % len(placements)]
+        for r in ok:
+            text = (format_value(r.point.axis_values[label_axis.label]) if label_axis
+                    else r.point.label)
+            ax.annotate(text, (r.wall_seconds, r.error), textcoords="offset points",
+                        xytext=offset, ha=ha, va=va, fontsize=7, color=line.get_color())
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.margins(0.12)  # room for the labels of the outermost points
+    ax.set_xlabel("wall time per run [s]")
+    ax.set_ylabel(f"error ({study.norm})")
+    title = "error versus cost"
+    if label_axis is not None:
+        title += f" (labels: {label_axis.label})"
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, which="both", alpha=0.25)
+    if len(groups) > 1:
+        ax.legend(fontsize=8, loc="best")
+    failed = len(results) - plotted
+    if failed:
+        ax.text(0.02, 0.02, f"{failed} point(s) not shown (failed, diverged or zero error; "
+                "see the table)", transform=ax.transAxes, fontsize=7, color="tab:red")
+
+
+def _plot_best(ax, study: Study, results: list) -> None:
+    best = best_result(results)
+    if best is None or best.sample is None:
+        ax.text(0.5, 0.5, "no point could be compared", ha="center", transform=ax.transAxes)
+        ax.set_axis_off()
+        return
+    sample, reference = best.sample, best.reference_values
+    if study.quantity.kind == "final":
+        _plot_final_values(ax, study, results)
+        return
+    every = max(1, len(sample.values) // 40)
+    ax.plot(sample.abscissa, reference, "k-", lw=1.6, label="reference")
+    ax.plot(sample.abscissa, sample.values, "o--", ms=3.5, lw=0.9, color="tab:red",
+            markevery=every, mfc="none", label=f"cosph, {best.point.label}")
+    if best.arrivals is not None:
+        ax.axhline(study.threshold, color="0.5", lw=0.8, ls=":", label="threshold")
+        for t, style in zip(best.arrivals, ("tab:red", "k")):
+            ax.axvline(t, color=style, lw=0.8, ls=":")
+    when = ""
+    if study.quantity.kind == "profile":
+        when = f" at t = {sample.variables['t'][0]:g}"
+    ax.set_xlabel("distance along the probe" if sample.abscissa_name == "distance"
+                  else sample.abscissa_name)
+    ax.set_ylabel(sample.field_name)
+    ax.set_title(f"best point{when}: error {best.error:.3g}", fontsize=10)
+    ax.grid(True, alpha=0.25)
+    ax.legend(fontsize=8, loc="best")
+
+
+def _plot_final_values(ax, study: Study, results: list) -> None:
+    ok = [r for r in results if r.status == "ok" and r.sample is not None]
+    ax.plot([r.particles for r in ok], [r.sample.values[-1] for r in ok], "o", color="tab:red",
+            label="cosph, final value")
+    ax.axhline(ok[0].reference_values[-1], color="k", lw=1.4, label="reference")
+    ax.set_xscale("log")
+    ax.set_xlabel("particles")
+    ax.set_ylabel(ok[0].sample.field_name)
+    ax.set_title("final value per point", fontsize=10)
+    ax.grid(True, alpha=0.25)
+    ax.legend(fontsize=8)
+
+
+def write_plot(path: Path, study: Study, results: list) -> None:
+    fig, (left, right) = plt.subplots(1, 2, figsize=(13, 5.2))
+    try:
+        _plot_error_cost(left, study, results)
+        _plot_best(right, study, results)
+        fig.suptitle(study.title, fontsize=12)
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+    finally:
+        plt.close(fig)
+
+
+# ---- Driver -----------------------------------------------------------------------------------
+
+@dataclass
+class StudyRun:
+    study: Study
+    results: list
+    out_dir: Path
+    seconds: float
+    files: dict = field(default_factory=dict)  # results, table, plot -> path
+
+
+def run_study(study: Study, cosph: Path, out_dir: Path, repeat: int, timeout: float,
+              log: Callable[[str], None] = print) -> StudyRun:
+    """Runs every point of a study and writes results.csv, table.md and plot.png (OSError when
+    one cannot be written)."""
+    start = time.monotonic()
+    points = study.points()
+    results = []
+    for point in points:
+        result = run_point(study, point, cosph, out_dir / "points" / str(point.index), repeat,
+                           timeout)
+        results.append(result)
+        log(f"[{point.index + 1}/{len(points)}] {point.label}: {result.status}"
+            + (f" ({result.message})" if result.message else "")
+            + f"  error {result.error:.3e}  wall {result.wall_seconds:.3f} s")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    files = {"results": out_dir / "results.csv", "table": out_dir / "table.md",
+             "plot": out_dir / "plot.png"}
+    write_results_csv(files["results"], study, results)
+    write_table(files["table"], study, results)
+    write_plot(files["plot"], study, results)
+    return StudyRun(study, results, out_dir, time.monotonic() - start, files)
+
+
+def parse_args(argv: Optional[list]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(
+        description="Run an accuracy-versus-cost study of cosph (see bench/studies/).")
+    parser.add_argument("study", type=Path, help="study file (YAML)")
+    parser.add_argument("--cosph", type=Path, default=DEFAULT_COSPH,
+                        help="cosph executable (default: %(default)s)")
+    parser.add_argument("--out", type=Path,
+                        help="output directory (default: bench/results/<study name>/)")
+    parser.add_argument("--repeat", type=int,
+                        help="runs per point; the minimum wall time counts (default: the "
+                             "study's 'repeat', else 1)")
+    parser.add_argument("--timeout", type=float, default=900.0,
+                        help="seconds before one run counts as failed (default: %(default)s)")
+    parser.add_argument("--expect-max-error", type=float, metavar="X",
+                        help="exit 1 unless the best point's error is at most X (CI checks)")
+    args = parser.parse_args(argv)
+    if args.repeat is not None and args.repeat < 1:
+        parser.error("--repeat must be >= 1")
+    return args
+
+
+def resolve_cosph(path: Path) -> Path:
+    path = path.resolve()
+    if not (path.is_file() and os.access(path, os.X_OK)):
+        raise StudyError(f"no cosph executable at {path} (build it, or pass --cosph)")
+    return path
+
+
+def main(argv: Optional[list] = None) -> int:
+    args = parse_args(argv)
+    try:
+        study = load_study(args.study)
+        cosph = resolve_cosph(args.cosph)
+        check_first_point(study, cosph)
+    except StudyError as error:
+        print(f"study.py: error: {error}", file=sys.stderr)
+        return 2
+    out_dir = (args.out or REPO_ROOT / "bench" / "results" / study.name).resolve()
+    repeat = args.repeat or study.repeat
+    print(f"study {study.name}: {len(study.points())} point(s), scene {study.scene}, "
+          f"output {out_dir}")
+    try:
+        done = run_study(study, cosph, out_dir, repeat, args.timeout)
+    except OSError as error:
+        print(f"study.py: error: cannot write the results: {error}", file=sys.stderr)
+        return 1
+    best = best_result(done.results)
+    failed = sum(r.status != "ok" for r in done.results)
+    print(f"wrote {done.files['results']}, table.md, plot.png ({done.seconds:.1f} s, "
+          f"{failed} point(s) not ok)")
+    if best is not None:
+        print(f"best point: {best.point.label}  error {best.error:.4e}")
+    if args.expect_max_error is not None:
+        if best is None or not best.error <= args.expect_max_error:
+            found = "no point could be compared" if best is None else f"{best.error:.4e}"
+            print(f"study.py: error: best error {found} exceeds --expect-max-error "
+                  f"{args.expect_max_error:g}", file=sys.stderr)
+            return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
