@@ -1,6 +1,7 @@
 #include "module_catalogue.hpp"
 
 #include "diffusion/diffusion_module.hpp"
+#include "monodomain/monodomain_module.hpp"
 
 namespace cosph {
 
@@ -8,6 +9,7 @@ const ModuleRegistry& builtin_modules() {
   static const ModuleRegistry registry = [] {
     ModuleRegistry r;
     r.add("diffusion", make_diffusion_module);
+    r.add("monodomain", make_monodomain_module);
     return r;
   }();
   return registry;

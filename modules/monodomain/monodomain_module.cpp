@@ -1,0 +1,282 @@
+#include "monodomain/monodomain_module.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/parallel.hpp"
+#include "driver/scene_geometry.hpp"
+#include "expression/expression.hpp"
+#include "geometry/regions.hpp"
+#include "monodomain/ionic_model.hpp"
+#include "neighbour/cell_linked_list.hpp"
+#include "operators/diffusion_operator.hpp"
+
+namespace cosph {
+namespace {
+
+const std::vector<std::string> kSpaceVariables = {"x", "y", "z"};
+
+template <int D>
+class MonodomainModule final : public Module {
+ public:
+  MonodomainModule(const proto::ModuleSpec& spec, const ModuleContext& context)
+      : name_(spec.name()),
+        key_(context.key_path + ".monodomain"),
+        spec_(spec.monodomain()),
+        scene_(*context.scene),
+        scene_directory_(context.scene_directory),
+        particles_(spec.monodomain().body().name().empty() ? spec.name()
+                                                           : spec.monodomain().body().name()),
+        kernel_(build_kernel(spec.monodomain().body(), D)),
+        domain_(build_domain<D>(*context.scene)) {
+    try {
+      model_ = make_ionic_model(spec_.ionic_model());
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(key_ + ".ionic_model", e.what());
+    }
+  }
+
+  ModuleInfo info() const override {
+    ModuleInfo info;
+    info.type = "monodomain";
+    info.name = name_;
+    info.writes = {{"voltage", {"voltage"}}};
+    info.reads = {{"voltage", {"voltage"}}};
+    info.active_features.push_back("ionic model " + model_->name());
+    info.active_features.push_back(spec_.fibre_diffusivity() > 0.0 ? "anisotropic diffusion"
+                                                                   : "isotropic diffusion");
+    info.active_features.push_back("kernel " + kernel_name(kernel_.type()));
+    if (spec_.kernel_correction()) info.active_features.push_back("kernel correction");
+    if (!stimuli_.empty()) info.active_features.push_back("stimuli");
+    if (spec_.output_millivolts()) info.active_features.push_back("output in mV");
+    return info;
+  }
+
+  void initialize() override {
+    build_static_body<D>(scene_, spec_.body(), key_ + ".body", scene_directory_, kernel_,
+                         particles_);
+    const auto& x = particles_.vector("position");
+    const auto& volume = particles_.scalar("volume");
+    const FieldFlags state{.output = true, .checkpoint = true, .exchange = true};
+    auto& V = particles_.add_scalar("voltage", state);
+    auto& w = particles_.add_scalar("gate", {.output = true, .checkpoint = true});
+    auto& activation =
+        particles_.add_scalar("activation_time", {.output = true, .checkpoint = true});
+    if (spec_.output_millivolts()) particles_.add_scalar("voltage_mV", {.output = true});
+
+    const Expression v0 = parse(spec_.initial_voltage(), key_ + ".initial_voltage");
+    const Expression w0 = parse(spec_.initial_gate(), key_ + ".initial_gate");
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const auto p = point(x[i]);
+      V[i] = v0.evaluate(p);
+      w[i] = w0.evaluate(p);
+      activation[i] = V[i] >= spec_.activation_threshold() ? 0.0 : -1.0;  // -1: not activated
+    }
+
+    for (int k = 0; k < spec_.stimuli_size(); ++k) {
+      const auto& s = spec_.stimuli(k);
+      const std::string path = key_ + ".stimuli[" + std::to_string(k) + "]";
+      auto shape = build_shape<D>(s.region().shape(), path + ".region.shape");
+      Stimulus stimulus{select_region<D>(x, *shape), s.value(), s.start(),
+                        s.start() + s.duration()};
+      if (stimulus.particles.empty())
+        throw ConfigError(path + ".region", "the region contains no particle");
+      stimuli_.push_back(std::move(stimulus));
+    }
+    apply_stimuli();
+
+    Mat<D> tensor = spec_.diffusivity() * Mat<D>::Identity();
+    if (spec_.fibre_diffusivity() > 0.0) {
+      if (spec_.fibre_size() == 0)
+        throw ConfigError(key_ + ".fibre", "fibre_diffusivity needs a fibre direction");
+      Vec<D> f = to_vec<D>(spec_.fibre());
+      if (!(f.norm() > 0.0)) throw ConfigError(key_ + ".fibre", "must not be zero");
+      f.normalize();
+      tensor += spec_.fibre_diffusivity() * f * f.transpose();
+    }
+    neighbours_ = build_inner_list<D>(x, kernel_.support_radius(), domain_);
+    try {
+      diffusion_.setup(x, volume, neighbours_, kernel_, domain_,
+                       std::vector<Mat<D>>(x.size(), tensor), spec_.kernel_correction(),
+                       spec_.time_step_factor());
+    } catch (const RuntimeError& e) {
+      throw RuntimeError("module '" + name_ + "': " + e.what());
+    }
+    max_dt_ = spec_.has_time_step() ? spec_.time_step() : diffusion_.stable_dt();
+    update_derived();
+  }
+
+  double max_dt() const override { return max_dt_; }
+  double time() const override { return time_; }
+
+  void advance(double dt) override {
+    auto& V = particles_.scalar("voltage");
+    auto& w = particles_.scalar("gate");
+    const double half = 0.5 * dt;
+    previous_ = V;
+    // R_V(dt/2) then R_w(dt/2): local to each particle, one pass.
+    parallel_for_each_index(V.size(), [&](std::size_t i) {
+      V[i] = qss_update(V[i], model_->voltage(V[i], w[i]), half);
+      w[i] = qss_update(w[i], model_->gate(V[i], w[i]), half);
+    });
+    diffusion_.step(V, dt);
+    parallel_for_each_index(V.size(), [&](std::size_t i) {
+      w[i] = qss_update(w[i], model_->gate(V[i], w[i]), half);
+      V[i] = qss_update(V[i], model_->voltage(V[i], w[i]), half);
+    });
+    time_ += dt;
+    ++steps_;
+    apply_stimuli();
+    record_activation(dt);
+    update_derived();
+  }
+
+  void write(const std::string& port, FieldBuffer& out) const override {
+    check_port(port);
+    out.points = particles_.size();
+    out.arrays.clear();
+    out.arrays["voltage"] = {1, particles_.scalar("voltage")};
+  }
+
+  void read(const std::string& port, const FieldBuffer& in) override {
+    check_port(port);
+    auto it = in.arrays.find("voltage");
+    if (it == in.arrays.end() || in.points != particles_.size() || it->second.components != 1)
+      throw RuntimeError("module '" + name_ + "': port 'voltage' got a buffer of another shape");
+    particles_.scalar("voltage") = it->second.values;
+  }
+
+  void save(StateRecord& state) const override {
+    for (const char* f : {"voltage", "gate", "activation_time"})
+      state.arrays[f] = particles_.scalar(f);
+    state.scalars["time"] = time_;
+    state.integers["steps"] = steps_;
+  }
+
+  void load(const StateRecord& state) override {
+    for (const char* f : {"voltage", "gate", "activation_time"}) {
+      auto it = state.arrays.find(f);
+      if (it == state.arrays.end() || it->second.size() != particles_.size())
+        throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
+                           std::to_string(particles_.size()) + " values of '" + f + "'");
+      particles_.scalar(f) = it->second;
+    }
+    time_ = state.scalars.at("time");
+    steps_ = state.integers.at("steps");
+    update_derived();
+  }
+
+  void bodies(BodyViews& views) const override {
+    BodyView<D> view{name_, &particles_, kernel_, domain_};
+    if constexpr (D == 2)
+      views.bodies2.push_back(view);
+    else
+      views.bodies3.push_back(view);
+  }
+
+  std::size_t particle_count() const override { return particles_.size(); }
+
+  std::optional<HealthProblem> check_health() const override {
+    double vmin = model_->voltage_min(), vmax = model_->voltage_max();
+    for (const auto& s : stimuli_) {
+      vmin = std::min(vmin, s.value);
+      vmax = std::max(vmax, s.value);
+    }
+    const auto& V = particles_.scalar("voltage");
+    const auto& w = particles_.scalar("gate");
+    for (std::size_t i = 0; i < V.size(); ++i) {
+      if (V[i] < vmin || V[i] > vmax) return problem("voltage", i, V[i], vmin, vmax);
+      if (w[i] < model_->gate_min() || w[i] > model_->gate_max())
+        return problem("gate", i, w[i], model_->gate_min(), model_->gate_max());
+    }
+    return std::nullopt;
+  }
+
+ private:
+  struct Stimulus {
+    std::vector<Index> particles;
+    double value, start, end;
+  };
+
+  Expression parse(const std::string& text, const std::string& key) const {
+    try {
+      return Expression::parse(text, kSpaceVariables);
+    } catch (const ExpressionError& e) {
+      throw ConfigError(key, e.what());
+    }
+  }
+
+  static std::array<double, 3> point(const Vec<D>& x) {
+    std::array<double, 3> p{0.0, 0.0, 0.0};
+    for (int a = 0; a < D; ++a) p[a] = x[a];
+    return p;
+  }
+
+  HealthProblem problem(const std::string& quantity, std::size_t i, double value, double lo,
+                        double hi) const {
+    std::ostringstream expected;
+    expected << "within [" << lo << ", " << hi << "] (" << model_->name() << " physical range)";
+    return {quantity, static_cast<long long>(i), value, expected.str()};
+  }
+
+  void apply_stimuli() {
+    auto& V = particles_.scalar("voltage");
+    for (const auto& s : stimuli_)
+      if (time_ >= s.start && time_ < s.end)
+        for (Index i : s.particles) V[i] = s.value;
+  }
+
+  // Activation time: the first upward crossing of the threshold, linearly interpolated in time.
+  void record_activation(double dt) {
+    const auto& V = particles_.scalar("voltage");
+    auto& activation = particles_.scalar("activation_time");
+    const double threshold = spec_.activation_threshold();
+    parallel_for_each_index(V.size(), [&](std::size_t i) {
+      if (activation[i] >= 0.0 || V[i] < threshold) return;
+      const double before = previous_[i];
+      const double fraction =
+          V[i] > before ? std::clamp((threshold - before) / (V[i] - before), 0.0, 1.0) : 1.0;
+      activation[i] = time_ - dt + fraction * dt;
+    });
+  }
+
+  void update_derived() {
+    if (!spec_.output_millivolts()) return;
+    const auto& V = particles_.scalar("voltage");
+    auto& E = particles_.scalar("voltage_mV");
+    for (std::size_t i = 0; i < V.size(); ++i)
+      E[i] = 100.0 * V[i] - 80.0;  // Aliev-Panfilov scaling
+  }
+
+  void check_port(const std::string& port) const {
+    if (port != "voltage")
+      throw RuntimeError("module '" + name_ + "' has no port '" + port + "' (it has 'voltage')");
+  }
+
+  std::string name_, key_;
+  proto::MonodomainSpec spec_;
+  const proto::Scene& scene_;
+  std::string scene_directory_;
+  ParticleSet<D> particles_;
+  Kernel kernel_;
+  Domain<D> domain_;
+  std::unique_ptr<IonicModel> model_;
+  NeighbourList neighbours_;
+  ExplicitDiffusion<D> diffusion_;
+  std::vector<Stimulus> stimuli_;
+  std::vector<double> previous_;
+  double max_dt_ = 0.0, time_ = 0.0;
+  long long steps_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Module> make_monodomain_module(const proto::ModuleSpec& spec,
+                                               const ModuleContext& context) {
+  if (context.scene->dimension() == 2) return std::make_unique<MonodomainModule<2>>(spec, context);
+  return std::make_unique<MonodomainModule<3>>(spec, context);
+}
+
+}  // namespace cosph
