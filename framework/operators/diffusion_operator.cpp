@@ -110,7 +110,7 @@ void ExplicitDiffusion<D>::setup(const std::vector<Vec<D>>& positions,
                                  const NeighbourList& neighbours, const Kernel& kernel,
                                  const Domain<D>& domain,
                                  const std::vector<Mat<D>>& diffusion_tensor, bool corrected,
-                                 double time_step_factor) {
+                                 double time_step_factor, Limit limit) {
   neighbours_ = &neighbours;
   weights_ = diffusion_pair_weights<D>(positions, volumes, neighbours, kernel, domain,
                                        diffusion_tensor, corrected);
@@ -118,14 +118,50 @@ void ExplicitDiffusion<D>::setup(const std::vector<Vec<D>>& positions,
   for (const auto& t : diffusion_tensor) max_trace = std::max(max_trace, t.trace());
   const double h = kernel.smoothing_length();
   const double paper = time_step_factor * h * h / (D * max_trace);
-  double row_max = 0.0;
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    double row = 0.0;
-    for (std::size_t k = neighbours.offset[i]; k < neighbours.offset[i + 1]; ++k)
-      row += weights_[k];
-    row_max = std::max(row_max, row);
+  if (limit == Limit::Monotone) {
+    double row_max = 0.0;
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+      double row = 0.0;
+      for (std::size_t k = neighbours.offset[i]; k < neighbours.offset[i + 1]; ++k)
+        row += weights_[k];
+      row_max = std::max(row_max, row);
+    }
+    stable_dt_ = row_max > 0.0 ? std::min(paper, 1.0 / row_max) : paper;
+  } else {
+    const double lambda = spectral_radius();
+    stable_dt_ = lambda > 0.0 ? std::min(paper, 0.9 * 2.0 / lambda) : paper;
   }
-  stable_dt_ = row_max > 0.0 ? std::min(paper, 1.0 / row_max) : paper;
+}
+
+template <int D>
+double ExplicitDiffusion<D>::spectral_radius() const {
+  // The operator is V^-1 S with S symmetric negative semi-definite (V_i w_ij = V_j w_ji), so its
+  // eigenvalues are real and <= 0; power iteration from a fixed alternating start (rich in the
+  // shortest modes, which carry the largest eigenvalues) converges to the largest magnitude.
+  const std::size_t n = neighbours_->particle_count();
+  if (n == 0) return 0.0;
+  std::vector<double> v(n), w;
+  for (std::size_t i = 0; i < n; ++i) v[i] = (i % 2 ? 1.0 : -1.0) * (1.0 + 0.01 * double(i % 7));
+  double lambda = 0.0;
+  for (int iteration = 0; iteration < 300; ++iteration) {
+    apply_diffusion(*neighbours_, weights_, v, w);
+    double norm_v = 0.0, norm_w = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      norm_v += v[i] * v[i];
+      norm_w += w[i] * w[i];
+    }
+    if (norm_w == 0.0) return 0.0;
+    lambda = std::sqrt(norm_w / norm_v);
+    const double scale = 1.0 / std::sqrt(norm_w);
+    for (std::size_t i = 0; i < n; ++i) v[i] = w[i] * scale;
+  }
+  return lambda;
+}
+
+template <int D>
+const std::vector<double>& ExplicitDiffusion<D>::rate(const std::vector<double>& c) {
+  apply_diffusion(*neighbours_, weights_, c, rate_);
+  return rate_;
 }
 
 template <int D>

@@ -64,17 +64,26 @@ namespace cosph {
 template <int D>
 class ExplicitDiffusion {
  public:
-  // `time_step_factor`: dt = factor * h^2 / (d max tr D) (seed 001), capped by the Gershgorin
-  // bound 1 / max_i sum_j w_ij of the assembled operator, which guarantees stability (and the
-  // discrete maximum principle, the weights being positive) even where the kernel correction
-  // enlarges weights near boundaries.
+  // How the step limit dt = factor * h^2 / (d max tr D) of seed 001 is made safe:
+  //  - Monotone: also dt <= 1 / max_i sum_j w_ij (Gershgorin). Each step is then a convex
+  //    combination (weights are positive): stable, and c obeys the discrete maximum principle.
+  //  - Stable: also dt <= 0.9 * 2 / lambda_max, lambda_max the operator's largest eigenvalue
+  //    magnitude (power iteration at set-up). Stable but not monotone; used where other terms
+  //    (reactions) break the maximum principle anyway, and it allows the paper's larger step.
+  enum class Limit { Monotone, Stable };
+
   void setup(const std::vector<Vec<D>>& positions, const std::vector<double>& volumes,
              const NeighbourList& neighbours, const Kernel& kernel, const Domain<D>& domain,
-             const std::vector<Mat<D>>& diffusion_tensor, bool corrected, double time_step_factor);
+             const std::vector<Mat<D>>& diffusion_tensor, bool corrected, double time_step_factor,
+             Limit limit = Limit::Monotone);
 
   double stable_dt() const { return stable_dt_; }
   // c_i += dt * sum_j w_ij (c_j - c_i).
   void step(std::vector<double>& c, double dt);
+  // rate_i = sum_j w_ij (c_j - c_i), for callers that fuse the update with other local work.
+  const std::vector<double>& rate(const std::vector<double>& c);
+  // Largest eigenvalue magnitude of the assembled operator (power iteration).
+  double spectral_radius() const;
 
  private:
   const NeighbourList* neighbours_ = nullptr;

@@ -100,11 +100,12 @@ class MonodomainModule final : public Module {
     try {
       diffusion_.setup(x, volume, neighbours_, kernel_, domain_,
                        std::vector<Mat<D>>(x.size(), tensor), spec_.kernel_correction(),
-                       spec_.time_step_factor());
+                       spec_.time_step_factor(), ExplicitDiffusion<D>::Limit::Stable);
     } catch (const RuntimeError& e) {
       throw RuntimeError("module '" + name_ + "': " + e.what());
     }
     max_dt_ = spec_.has_time_step() ? spec_.time_step() : diffusion_.stable_dt();
+    previous_.resize(x.size());
     update_derived();
   }
 
@@ -114,22 +115,30 @@ class MonodomainModule final : public Module {
   void advance(double dt) override {
     auto& V = particles_.scalar("voltage");
     auto& w = particles_.scalar("gate");
-    const double half = 0.5 * dt;
-    previous_ = V;
-    // R_V(dt/2) then R_w(dt/2): local to each particle, one pass.
+    auto& activation = particles_.scalar("activation_time");
+    const double half = 0.5 * dt, threshold = spec_.activation_threshold();
+    const double t_end = time_ + dt;
+    // Three passes: the first reaction half steps (local), the diffusion rate (gather), then the
+    // diffusion update fused with the second reaction half steps and the activation record.
     parallel_for_each_index(V.size(), [&](std::size_t i) {
-      V[i] = qss_update(V[i], model_->voltage(V[i], w[i]), half);
-      w[i] = qss_update(w[i], model_->gate(V[i], w[i]), half);
+      previous_[i] = V[i];
+      react_before_diffusion(*model_, V[i], w[i], half);
     });
-    diffusion_.step(V, dt);
+    const std::vector<double>& rate = diffusion_.rate(V);
     parallel_for_each_index(V.size(), [&](std::size_t i) {
-      w[i] = qss_update(w[i], model_->gate(V[i], w[i]), half);
-      V[i] = qss_update(V[i], model_->voltage(V[i], w[i]), half);
+      V[i] += dt * rate[i];
+      react_after_diffusion(*model_, V[i], w[i], half);
+      // Activation time: the first upward crossing of the threshold, interpolated in time.
+      if (activation[i] < 0.0 && V[i] >= threshold) {
+        const double before = previous_[i];
+        const double fraction =
+            V[i] > before ? std::clamp((threshold - before) / (V[i] - before), 0.0, 1.0) : 1.0;
+        activation[i] = t_end - dt + fraction * dt;
+      }
     });
-    time_ += dt;
+    time_ = t_end;
     ++steps_;
     apply_stimuli();
-    record_activation(dt);
     update_derived();
   }
 
@@ -226,20 +235,6 @@ class MonodomainModule final : public Module {
     for (const auto& s : stimuli_)
       if (time_ >= s.start && time_ < s.end)
         for (Index i : s.particles) V[i] = s.value;
-  }
-
-  // Activation time: the first upward crossing of the threshold, linearly interpolated in time.
-  void record_activation(double dt) {
-    const auto& V = particles_.scalar("voltage");
-    auto& activation = particles_.scalar("activation_time");
-    const double threshold = spec_.activation_threshold();
-    parallel_for_each_index(V.size(), [&](std::size_t i) {
-      if (activation[i] >= 0.0 || V[i] < threshold) return;
-      const double before = previous_[i];
-      const double fraction =
-          V[i] > before ? std::clamp((threshold - before) / (V[i] - before), 0.0, 1.0) : 1.0;
-      activation[i] = time_ - dt + fraction * dt;
-    });
   }
 
   void update_derived() {
