@@ -467,7 +467,8 @@ def evaluate_reference(reference: Reference, variables: dict) -> np.ndarray:
     if reference.kind == "value":
         return np.full(shape, reference.value)
     if reference.kind == "csv":
-        where = np.asarray(variables[reference.along], dtype=float)
+        where = np.asarray(variables["t" if reference.along == "time" else reference.along],
+                           dtype=float)
         # Outside the reference's range there is nothing to compare with: NaN, excluded later.
         return np.interp(where, reference.abscissa, reference.ordinate, left=np.nan,
                          right=np.nan)
@@ -620,8 +621,9 @@ def extract_sample(quantity: Quantity, out_dir: Path) -> Sample:
     if quantity.kind == "profile":
         return _profile_sample(quantity, times, columns, values, coordinates)
     if quantity.column not in columns:
+        shown = ", ".join(columns[:6]) + (", ..." if len(columns) > 6 else "")
         raise ComparisonError(f"probe '{quantity.probe}' has no column '{quantity.column}' "
-                              f"(it has {', '.join(columns[:6])}{', ...' if len(columns) > 6 else ''})")
+                              f"(it has {shown})")
     series = values[:, columns.index(quantity.column)]
     label = quantity.column.split("@", 1)[1] if "@" in quantity.column else None
     origin = next(iter(coordinates.values()), None)
@@ -700,6 +702,11 @@ def compare(study: Study, out_dir: Path, result: PointResult) -> None:
     usable = np.isfinite(reference)
     if not usable.any():
         raise ComparisonError("the reference is not finite at any sample")
+    if not usable.all():
+        # Outside a CSV reference's range, or where an expression is singular (t = 0 of a
+        # discontinuous start): nothing to compare with. Said in the table, not hidden.
+        result.message = (f"{np.count_nonzero(~usable)} of {usable.size} samples without a "
+                          "finite reference, left out")
     s, r = sample.values[usable], reference[usable]
     if study.norm == "max":
         result.error = float(np.max(np.abs(s - r)))
@@ -771,45 +778,62 @@ def quantity_text(quantity: Quantity) -> str:
     return f"final value of {quantity.column}"
 
 
-def _plot_groups(study: Study, results: list) -> tuple:
-    """Groups of results for the error-cost panel, and the axis whose value labels each point.
+@dataclass
+class PlotGroup:
+    name: str  # legend entry; empty for none
+    members: list
+    connect: bool  # the points form one convergence curve: join them
+    label_axis: Optional[Axis]  # points are labelled by this axis's value, else by their label
 
-    With two axes the points are grouped by the axis that is not the resolution (the one whose
-    key names a spacing, else the first), so that each group is one convergence curve."""
-    if study.explicit_points or not study.axes:
-        return [("", results)], None
-    resolution = next((a for a in study.axes if a.key.endswith("spacing")), study.axes[0])
-    if len(study.axes) != 2:
-        return [("", results)], resolution if len(study.axes) == 1 else None
-    other = next(a for a in study.axes if a is not resolution)
-    groups = [(f"{other.label} = {format_value(value)}",
-               [r for r in results if r.point.axis_values[other.label] == value])
-              for value in other.values]
-    return groups, resolution
+
+def _plot_groups(study: Study, results: list) -> list:
+    """Groups of results for the plots.
+
+    With two axes the swept points are grouped by the axis that is not the resolution (the one
+    whose key names a spacing, else the first), so that each group is one convergence curve.
+    Explicit points are unrelated settings: a group of their own, not joined by lines."""
+    swept = [r for r in results if r.point.axis_values]
+    explicit = [r for r in results if not r.point.axis_values]
+    groups = []
+    if swept:
+        resolution = next((a for a in study.axes if a.key.endswith("spacing")), study.axes[0])
+        if len(study.axes) == 2:
+            other = next(a for a in study.axes if a is not resolution)
+            groups += [PlotGroup(f"{other.label} = {format_value(value)}",
+                                 [r for r in swept if r.point.axis_values[other.label] == value],
+                                 True, resolution)
+                       for value in other.values]
+        elif len(study.axes) == 1:
+            groups.append(PlotGroup("sweep" if explicit else "", swept, True, resolution))
+        else:
+            groups.append(PlotGroup("sweep" if explicit else "", swept, False, None))
+    if explicit:
+        groups.append(PlotGroup("points" if swept else "", explicit, False, None))
+    return groups
 
 
 def _plot_error_cost(ax, study: Study, results: list) -> None:
-    groups, label_axis = _plot_groups(study, results)
+    groups = _plot_groups(study, results)
     markers = "osD^v<>p"
     # Points of different groups at one resolution sit close together: each group's labels go
     # to another side of its points, in the group's colour, so that they overlap less.
     placements = [((6, 3), "left", "bottom"), ((6, -3), "left", "top"),
                   ((-6, 3), "right", "bottom"), ((-6, -3), "right", "top")]
     plotted = 0
-    for g, (name, members) in enumerate(groups):
-        ok = [r for r in members if r.status == "ok" and math.isfinite(r.error)
+    for g, group in enumerate(groups):
+        ok = [r for r in group.members if r.status == "ok" and math.isfinite(r.error)
               and r.error > 0 and r.wall_seconds > 0]
         if not ok:
             continue
         plotted += len(ok)
         wall = [r.wall_seconds for r in ok]
         error = [r.error for r in ok]
-        (line,) = ax.plot(wall, error, marker=markers[g % len(markers)], ms=6, lw=1.2,
-                          label=name or None, alpha=0.9)
+        (line,) = ax.plot(wall, error, marker=markers[g % len(markers)], ms=6,
+                          lw=1.2 if group.connect else 0, label=group.name or None, alpha=0.9)
         offset, ha, va = placements[g % len(placements)]
         for r in ok:
-            text = (format_value(r.point.axis_values[label_axis.label]) if label_axis
-                    else r.point.label)
+            text = (format_value(r.point.axis_values[group.label_axis.label])
+                    if group.label_axis else r.point.label)
             ax.annotate(text, (r.wall_seconds, r.error), textcoords="offset points",
                         xytext=offset, ha=ha, va=va, fontsize=7, color=line.get_color())
     ax.set_xscale("log")
@@ -818,11 +842,12 @@ def _plot_error_cost(ax, study: Study, results: list) -> None:
     ax.set_xlabel("wall time per run [s]")
     ax.set_ylabel(f"error ({study.norm})")
     title = "error versus cost"
-    if label_axis is not None:
-        title += f" (labels: {label_axis.label})"
+    label_axes = {g.label_axis.label for g in groups if g.label_axis is not None}
+    if label_axes:
+        title += f" (labels: {', '.join(sorted(label_axes))})"
     ax.set_title(title, fontsize=10)
     ax.grid(True, which="both", alpha=0.25)
-    if len(groups) > 1:
+    if any(g.name for g in groups):
         ax.legend(fontsize=8, loc="best")
     failed = len(results) - plotted
     if failed:
@@ -851,19 +876,41 @@ def _plot_best(ax, study: Study, results: list) -> None:
     when = ""
     if study.quantity.kind == "profile":
         when = f" at t = {sample.variables['t'][0]:g}"
+    if best.arrivals is not None:
+        when = f", arrival {best.arrivals[0]:.4g} (reference {best.arrivals[1]:.4g})"
     ax.set_xlabel("distance along the probe" if sample.abscissa_name == "distance"
                   else sample.abscissa_name)
     ax.set_ylabel(sample.field_name)
     ax.set_title(f"best point{when}: error {best.error:.3g}", fontsize=10)
     ax.grid(True, alpha=0.25)
-    ax.legend(fontsize=8, loc="best")
+    # At small errors the two curves are indistinguishable: the difference, on its own scale,
+    # shows where the error is.
+    twin = ax.twinx()
+    twin.plot(sample.abscissa, sample.values - reference, color="tab:blue", lw=0.8, alpha=0.6,
+              label="cosph - reference (right axis)")
+    twin.set_ylabel("cosph - reference", color="tab:blue", fontsize=9)
+    twin.tick_params(axis="y", labelcolor="tab:blue", labelsize=8)
+    limit = np.nanmax(np.abs(sample.values - reference)) * 3.0
+    if np.isfinite(limit) and limit > 0:
+        twin.set_ylim(-limit, limit)  # zero in the middle, the curve in the middle third
+    handles = ax.get_legend_handles_labels()
+    extra = twin.get_legend_handles_labels()
+    # Below the axes: inside, a long point label would cover the curves.
+    ax.legend(handles[0] + extra[0], handles[1] + extra[1], fontsize=8, loc="upper center",
+              bbox_to_anchor=(0.5, -0.13), ncol=3, frameon=False)
 
 
 def _plot_final_values(ax, study: Study, results: list) -> None:
-    ok = [r for r in results if r.status == "ok" and r.sample is not None]
-    ax.plot([r.particles for r in ok], [r.sample.values[-1] for r in ok], "o", color="tab:red",
-            label="cosph, final value")
-    ax.axhline(ok[0].reference_values[-1], color="k", lw=1.4, label="reference")
+    """A single final value has no curve: every point's value against particle count."""
+    reference = None
+    for group in _plot_groups(study, results):
+        ok = [r for r in group.members if r.status == "ok" and r.sample is not None]
+        if ok:
+            ax.plot([r.particles for r in ok], [r.sample.values[-1] for r in ok],
+                    "o-" if group.connect else "o",
+                    label=f"cosph, {group.name}" if group.name else "cosph")
+            reference = ok[0].reference_values[-1]
+    ax.axhline(reference, color="k", lw=1.4, label="reference")
     ax.set_xscale("log")
     ax.set_xlabel("particles")
     ax.set_ylabel(ok[0].sample.field_name)
@@ -891,6 +938,7 @@ class StudyRun:
     study: Study
     results: list
     out_dir: Path
+    repeat: int
     seconds: float
     files: dict = field(default_factory=dict)  # results, table, plot -> path
 
@@ -915,7 +963,7 @@ def run_study(study: Study, cosph: Path, out_dir: Path, repeat: int, timeout: fl
     write_results_csv(files["results"], study, results)
     write_table(files["table"], study, results)
     write_plot(files["plot"], study, results)
-    return StudyRun(study, results, out_dir, time.monotonic() - start, files)
+    return StudyRun(study, results, out_dir, repeat, time.monotonic() - start, files)
 
 
 def parse_args(argv: Optional[list]) -> argparse.Namespace:
