@@ -1,5 +1,6 @@
 #include "module_catalogue.hpp"
 
+#include "active_stress/active_stress_module.hpp"
 #include "diffusion/diffusion_module.hpp"
 #include "monodomain/monodomain_module.hpp"
 
@@ -10,6 +11,7 @@ const ModuleRegistry& builtin_modules() {
     ModuleRegistry r;
     r.add("diffusion", make_diffusion_module);
     r.add("monodomain", make_monodomain_module);
+    r.add("active_stress", make_active_stress_module);
     return r;
   }();
   return registry;
