@@ -87,19 +87,32 @@ class MonodomainModule final : public Module {
     }
     apply_stimuli();
 
-    Mat<D> tensor = spec_.diffusivity() * Mat<D>::Identity();
+    std::vector<Mat<D>> tensors(x.size(), spec_.diffusivity() * Mat<D>::Identity());
     if (spec_.fibre_diffusivity() > 0.0) {
-      if (spec_.fibre_size() == 0)
-        throw ConfigError(key_ + ".fibre", "fibre_diffusivity needs a fibre direction");
-      Vec<D> f = to_vec<D>(spec_.fibre());
-      if (!(f.norm() > 0.0)) throw ConfigError(key_ + ".fibre", "must not be zero");
-      f.normalize();
-      tensor += spec_.fibre_diffusivity() * f * f.transpose();
+      const bool constant = spec_.fibre_size() > 0, field = spec_.fibre_field_size() > 0;
+      if (constant == field)
+        throw ConfigError(key_ + ".fibre", "fibre_diffusivity needs either fibre or fibre_field");
+      std::vector<Expression> components;
+      for (int a = 0; a < spec_.fibre_field_size(); ++a)
+        components.push_back(
+            parse(spec_.fibre_field(a), key_ + ".fibre_field[" + std::to_string(a) + "]"));
+      const Vec<D> constant_fibre = to_vec<D>(spec_.fibre());
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        Vec<D> f = constant_fibre;
+        if (field)
+          for (int a = 0; a < D; ++a) f[a] = components[a].evaluate(point(x[i]));
+        if (!(f.norm() > 0.0) || !f.allFinite()) {
+          std::ostringstream msg;
+          msg << "fibre direction is zero or not finite at (" << x[i].transpose() << ")";
+          throw ConfigError(key_ + (field ? ".fibre_field" : ".fibre"), msg.str());
+        }
+        f.normalize();
+        tensors[i] += spec_.fibre_diffusivity() * f * f.transpose();
+      }
     }
     neighbours_ = build_inner_list<D>(x, kernel_.support_radius(), domain_);
     try {
-      diffusion_.setup(x, volume, neighbours_, kernel_, domain_,
-                       std::vector<Mat<D>>(x.size(), tensor), spec_.kernel_correction(),
+      diffusion_.setup(x, volume, neighbours_, kernel_, domain_, tensors, spec_.kernel_correction(),
                        spec_.time_step_factor(), ExplicitDiffusion<D>::Limit::Stable);
     } catch (const RuntimeError& e) {
       throw RuntimeError("module '" + name_ + "': " + e.what());
