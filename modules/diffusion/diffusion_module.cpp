@@ -7,8 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
-#include "driver/scene_geometry.hpp"
-#include "expression/expression.hpp"
+#include "driver/static_body_module.hpp"
 #include "geometry/regions.hpp"
 #include "neighbour/cell_linked_list.hpp"
 #include "operators/diffusion_operator.hpp"
@@ -18,28 +17,20 @@ namespace {
 
 const std::vector<std::string> kSpaceTimeVariables = {"x", "y", "z", "t"};
 
-Expression parse_expression(const std::string& text, const std::vector<std::string>& variables,
-                            const std::string& key_path) {
-  try {
-    return Expression::parse(text, variables);
-  } catch (const ExpressionError& e) {
-    throw ConfigError(key_path, e.what());
-  }
-}
-
 template <int D>
-class DiffusionModule final : public Module {
+class DiffusionModule final : public StaticBodyModule<D> {
+  using Base = StaticBodyModule<D>;
+  using Base::domain_;
+  using Base::kernel_;
+  using Base::key_;
+  using Base::name_;
+  using Base::particles_;
+  using Base::steps_;
+  using Base::time_;
+
  public:
   DiffusionModule(const proto::ModuleSpec& spec, const ModuleContext& context)
-      : name_(spec.name()),
-        key_(context.key_path + ".diffusion"),
-        spec_(spec.diffusion()),
-        scene_(*context.scene),
-        scene_directory_(context.scene_directory),
-        particles_(spec.diffusion().body().name().empty() ? spec.name()
-                                                          : spec.diffusion().body().name()),
-        kernel_(build_kernel(spec.diffusion().body(), D)),
-        domain_(build_domain<D>(*context.scene)) {}
+      : Base(spec, context, "diffusion", spec.diffusion().body()), spec_(spec.diffusion()) {}
 
   ModuleInfo info() const override {
     ModuleInfo info;
@@ -61,18 +52,16 @@ class DiffusionModule final : public Module {
     if (has_iso == has_aniso) throw ConfigError(key_, "give either diffusivity or anisotropy");
     const Mat<D> tensor = diffusion_tensor();
 
-    build_static_body<D>(scene_, spec_.body(), key_ + ".body", scene_directory_, kernel_,
-                         particles_);
+    Base::build_body();
     const auto& x = particles_.vector("position");
     const auto& V = particles_.scalar("volume");
     auto& c = particles_.add_scalar(spec_.field(),
                                     {.output = true, .checkpoint = true, .exchange = true});
 
     const Expression initial =
-        parse_expression(spec_.initial(), kSpaceTimeVariables, key_ + ".initial");
+        Base::parse_expression(spec_.initial(), kSpaceTimeVariables, key_ + ".initial");
     for (std::size_t i = 0; i < x.size(); ++i) {
-      const auto p = point(x[i], 0.0);
-      c[i] = initial.evaluate(std::span<const double>(p.data(), p.size()));
+      c[i] = initial.evaluate(Base::space_time(x[i], 0.0));
     }
 
     for (int k = 0; k < spec_.fixed_values_size(); ++k) {
@@ -80,7 +69,7 @@ class DiffusionModule final : public Module {
       const auto& fv = spec_.fixed_values(k);
       auto shape = build_shape<D>(fv.region().shape(), path + ".region.shape");
       Fixed fixed{select_region<D>(x, *shape),
-                  parse_expression(fv.value(), kSpaceTimeVariables, path + ".value")};
+                  Base::parse_expression(fv.value(), kSpaceTimeVariables, path + ".value")};
       if (fixed.particles.empty())
         throw ConfigError(path + ".region", "the region contains no particle");
       fixed_.push_back(std::move(fixed));
@@ -125,7 +114,6 @@ class DiffusionModule final : public Module {
   }
 
   double max_dt() const override { return max_dt_; }
-  double time() const override { return time_; }
 
   void advance(double dt) override {
     diffusion_.step(particles_.scalar(spec_.field()), dt);
@@ -136,52 +124,27 @@ class DiffusionModule final : public Module {
 
   void write(const std::string& port, FieldBuffer& out) const override {
     check_port(port);
-    out.points = particles_.size();
-    out.arrays.clear();
-    const auto& c = particles_.scalar(spec_.field());
-    out.arrays[spec_.field()] = {1, c};
+    Base::write_scalar_port(spec_.field(), out);
   }
 
   void read(const std::string& port, const FieldBuffer& in) override {
     check_port(port);
-    auto it = in.arrays.find(spec_.field());
-    if (it == in.arrays.end() || in.points != particles_.size() || it->second.components != 1)
-      throw RuntimeError("module '" + name_ + "': port '" + port +
-                         "' got a buffer of another shape");
-    particles_.scalar(spec_.field()) = it->second.values;
+    Base::read_scalar_port(port, spec_.field(), in);
   }
 
   void save(StateRecord& state) const override {
-    state.arrays[spec_.field()] = particles_.scalar(spec_.field());
+    Base::save_state(state, {spec_.field()});
     state.scalars["lower_bound"] = lower_;
     state.scalars["upper_bound"] = upper_;
     state.scalars["initial_energy"] = initial_energy_;
-    state.scalars["time"] = time_;
-    state.integers["steps"] = steps_;
   }
 
   void load(const StateRecord& state) override {
-    auto it = state.arrays.find(spec_.field());
-    if (it == state.arrays.end() || it->second.size() != particles_.size())
-      throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
-                         std::to_string(particles_.size()) + " values of '" + spec_.field() + "'");
-    particles_.scalar(spec_.field()) = it->second;
-    time_ = state.scalars.at("time");
+    Base::load_state(state, {spec_.field()});
     lower_ = state.scalars.at("lower_bound");
     upper_ = state.scalars.at("upper_bound");
     initial_energy_ = state.scalars.at("initial_energy");
-    steps_ = state.integers.at("steps");
   }
-
-  void bodies(BodyViews& views) const override {
-    BodyView<D> view{name_, &particles_, kernel_, domain_};
-    if constexpr (D == 2)
-      views.bodies2.push_back(view);
-    else
-      views.bodies3.push_back(view);
-  }
-
-  std::size_t particle_count() const override { return particles_.size(); }
 
  private:
   struct Fixed {
@@ -198,19 +161,12 @@ class DiffusionModule final : public Module {
     return a.across() * Mat<D>::Identity() + (a.along() - a.across()) * f * f.transpose();
   }
 
-  static std::array<double, 4> point(const Vec<D>& x, double t) {
-    std::array<double, 4> p{0.0, 0.0, 0.0, t};
-    for (int a = 0; a < D; ++a) p[a] = x[a];
-    return p;
-  }
-
   void apply_fixed_values() {
     auto& c = particles_.scalar(spec_.field());
     const auto& x = particles_.vector("position");
     for (const auto& f : fixed_)
       for (Index i : f.particles) {
-        const auto p = point(x[i], time_);
-        c[i] = f.value.evaluate(std::span<const double>(p.data(), 4));
+        c[i] = f.value.evaluate(Base::space_time(x[i], time_));
         // Boundary values widen the range the maximum principle allows.
         lower_ = std::min(lower_, c[i]);
         upper_ = std::max(upper_, c[i]);
@@ -229,19 +185,12 @@ class DiffusionModule final : public Module {
                          spec_.field() + "')");
   }
 
-  std::string name_, key_;
   proto::DiffusionSpec spec_;
-  const proto::Scene& scene_;
-  std::string scene_directory_;
-  ParticleSet<D> particles_;
-  Kernel kernel_;
-  Domain<D> domain_;
   NeighbourList neighbours_;
   ExplicitDiffusion<D> diffusion_;
   std::vector<Fixed> fixed_;
-  double max_dt_ = 0.0, time_ = 0.0;
+  double max_dt_ = 0.0;
   double lower_ = INFINITY, upper_ = -INFINITY, initial_energy_ = 0.0;
-  long long steps_ = 0;
 };
 
 }  // namespace

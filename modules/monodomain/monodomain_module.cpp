@@ -6,8 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
-#include "driver/scene_geometry.hpp"
-#include "expression/expression.hpp"
+#include "driver/static_body_module.hpp"
 #include "geometry/regions.hpp"
 #include "monodomain/ionic_model.hpp"
 #include "neighbour/cell_linked_list.hpp"
@@ -19,18 +18,19 @@ namespace {
 const std::vector<std::string> kSpaceVariables = {"x", "y", "z"};
 
 template <int D>
-class MonodomainModule final : public Module {
+class MonodomainModule final : public StaticBodyModule<D> {
+  using Base = StaticBodyModule<D>;
+  using Base::domain_;
+  using Base::kernel_;
+  using Base::key_;
+  using Base::name_;
+  using Base::particles_;
+  using Base::steps_;
+  using Base::time_;
+
  public:
   MonodomainModule(const proto::ModuleSpec& spec, const ModuleContext& context)
-      : name_(spec.name()),
-        key_(context.key_path + ".monodomain"),
-        spec_(spec.monodomain()),
-        scene_(*context.scene),
-        scene_directory_(context.scene_directory),
-        particles_(spec.monodomain().body().name().empty() ? spec.name()
-                                                           : spec.monodomain().body().name()),
-        kernel_(build_kernel(spec.monodomain().body(), D)),
-        domain_(build_domain<D>(*context.scene)) {
+      : Base(spec, context, "monodomain", spec.monodomain().body()), spec_(spec.monodomain()) {
     try {
       model_ = make_ionic_model(spec_.ionic_model());
     } catch (const std::invalid_argument& e) {
@@ -55,8 +55,7 @@ class MonodomainModule final : public Module {
   }
 
   void initialize() override {
-    build_static_body<D>(scene_, spec_.body(), key_ + ".body", scene_directory_, kernel_,
-                         particles_);
+    Base::build_body();
     const auto& x = particles_.vector("position");
     const auto& volume = particles_.scalar("volume");
     const FieldFlags state{.output = true, .checkpoint = true, .exchange = true};
@@ -123,7 +122,6 @@ class MonodomainModule final : public Module {
   }
 
   double max_dt() const override { return max_dt_; }
-  double time() const override { return time_; }
 
   void advance(double dt) override {
     auto& V = particles_.scalar("voltage");
@@ -157,48 +155,20 @@ class MonodomainModule final : public Module {
 
   void write(const std::string& port, FieldBuffer& out) const override {
     check_port(port);
-    out.points = particles_.size();
-    out.arrays.clear();
-    out.arrays["voltage"] = {1, particles_.scalar("voltage")};
+    Base::write_scalar_port("voltage", out);
   }
 
   void read(const std::string& port, const FieldBuffer& in) override {
     check_port(port);
-    auto it = in.arrays.find("voltage");
-    if (it == in.arrays.end() || in.points != particles_.size() || it->second.components != 1)
-      throw RuntimeError("module '" + name_ + "': port 'voltage' got a buffer of another shape");
-    particles_.scalar("voltage") = it->second.values;
+    Base::read_scalar_port(port, "voltage", in);
   }
 
-  void save(StateRecord& state) const override {
-    for (const char* f : {"voltage", "gate", "activation_time"})
-      state.arrays[f] = particles_.scalar(f);
-    state.scalars["time"] = time_;
-    state.integers["steps"] = steps_;
-  }
+  void save(StateRecord& state) const override { Base::save_state(state, kStateFields); }
 
   void load(const StateRecord& state) override {
-    for (const char* f : {"voltage", "gate", "activation_time"}) {
-      auto it = state.arrays.find(f);
-      if (it == state.arrays.end() || it->second.size() != particles_.size())
-        throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
-                           std::to_string(particles_.size()) + " values of '" + f + "'");
-      particles_.scalar(f) = it->second;
-    }
-    time_ = state.scalars.at("time");
-    steps_ = state.integers.at("steps");
+    Base::load_state(state, kStateFields);
     update_derived();
   }
-
-  void bodies(BodyViews& views) const override {
-    BodyView<D> view{name_, &particles_, kernel_, domain_};
-    if constexpr (D == 2)
-      views.bodies2.push_back(view);
-    else
-      views.bodies3.push_back(view);
-  }
-
-  std::size_t particle_count() const override { return particles_.size(); }
 
   std::optional<HealthProblem> check_health() const override {
     double vmin = model_->voltage_min(), vmax = model_->voltage_max();
@@ -222,18 +192,13 @@ class MonodomainModule final : public Module {
     double value, start, end;
   };
 
-  Expression parse(const std::string& text, const std::string& key) const {
-    try {
-      return Expression::parse(text, kSpaceVariables);
-    } catch (const ExpressionError& e) {
-      throw ConfigError(key, e.what());
-    }
+  static Expression parse(const std::string& text, const std::string& key) {
+    return Base::parse_expression(text, kSpaceVariables, key);
   }
 
   static std::array<double, 3> point(const Vec<D>& x) {
-    std::array<double, 3> p{0.0, 0.0, 0.0};
-    for (int a = 0; a < D; ++a) p[a] = x[a];
-    return p;
+    const auto p = Base::space_time(x, 0.0);
+    return {p[0], p[1], p[2]};
   }
 
   HealthProblem problem(const std::string& quantity, std::size_t i, double value, double lo,
@@ -263,20 +228,15 @@ class MonodomainModule final : public Module {
       throw RuntimeError("module '" + name_ + "' has no port '" + port + "' (it has 'voltage')");
   }
 
-  std::string name_, key_;
+  inline static const std::vector<std::string> kStateFields = {"voltage", "gate",
+                                                               "activation_time"};
   proto::MonodomainSpec spec_;
-  const proto::Scene& scene_;
-  std::string scene_directory_;
-  ParticleSet<D> particles_;
-  Kernel kernel_;
-  Domain<D> domain_;
   std::unique_ptr<IonicModel> model_;
   NeighbourList neighbours_;
   ExplicitDiffusion<D> diffusion_;
   std::vector<Stimulus> stimuli_;
   std::vector<double> previous_;
-  double max_dt_ = 0.0, time_ = 0.0;
-  long long steps_ = 0;
+  double max_dt_ = 0.0;
 };
 
 }  // namespace
