@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "bench_lattice.hpp"
 #include "kernels/kernel_correction.hpp"
 #include "neighbour/cell_linked_list.hpp"
 #include "operators/diffusion_operator.hpp"
@@ -23,21 +24,7 @@ struct Cloud {
 
   explicit Cloud(std::size_t target) {
     const double dp = 0.01;
-    const int n = static_cast<int>(std::round(std::pow(double(target), 1.0 / D)));
-    std::mt19937 rng(1);
-    std::uniform_real_distribution<double> u(-0.2 * dp, 0.2 * dp);
-    std::array<int, D> k{};
-    while (true) {
-      Vec<D> p;
-      for (int a = 0; a < D; ++a) p[a] = (k[a] + 0.5) * dp + u(rng);
-      x.push_back(p);
-      int a = 0;
-      for (; a < D; ++a) {
-        if (++k[a] < n) break;
-        k[a] = 0;
-      }
-      if (a == D) break;
-    }
+    x = bench::jittered_lattice<D>(target, dp, 0.2);
     V.assign(x.size(), std::pow(dp, D));
     neighbours = build_inner_list<D>(x, kernel.support_radius(), domain);
   }

@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "bench_lattice.hpp"
 #include "core/parallel.hpp"
 #include "monodomain/ionic_model.hpp"
 #include "neighbour/cell_linked_list.hpp"
@@ -23,19 +24,7 @@ struct Tissue {
 
   explicit Tissue(std::size_t target) {
     const double dp = 0.01;
-    const int n = static_cast<int>(std::round(std::pow(double(target), 1.0 / D)));
-    std::array<int, D> k{};
-    while (true) {
-      Vec<D> p;
-      for (int a = 0; a < D; ++a) p[a] = (k[a] + 0.5) * dp;
-      x.push_back(p);
-      int a = 0;
-      for (; a < D; ++a) {
-        if (++k[a] < n) break;
-        k[a] = 0;
-      }
-      if (a == D) break;
-    }
+    x = bench::jittered_lattice<D>(target, dp, 0.0);
     volume.assign(x.size(), std::pow(dp, D));
     std::mt19937 rng(2);
     std::uniform_real_distribution<double> u(0.0, 1.0);

@@ -5,29 +5,14 @@
 
 #include <random>
 
+#include "bench_lattice.hpp"
 #include "neighbour/cell_linked_list.hpp"
 
 namespace {
 
 template <int D>
 std::vector<cosph::Vec<D>> lattice(std::size_t target, double dp) {
-  const int n = static_cast<int>(std::round(std::pow(double(target), 1.0 / D)));
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<double> u(-0.1 * dp, 0.1 * dp);
-  std::vector<cosph::Vec<D>> x;
-  std::array<int, D> k{};
-  while (true) {
-    cosph::Vec<D> p;
-    for (int a = 0; a < D; ++a) p[a] = (k[a] + 0.5) * dp + u(rng);
-    x.push_back(p);
-    int a = 0;
-    for (; a < D; ++a) {
-      if (++k[a] < n) break;
-      k[a] = 0;
-    }
-    if (a == D) break;
-  }
-  return x;
+  return cosph::bench::jittered_lattice<D>(target, dp, 0.1);
 }
 
 template <int D>
