@@ -88,6 +88,12 @@ class Quantity:
     field: Optional[str]
     column: Optional[str]
     time: Any  # "last" or a simulated time (profile only)
+    # A final value derived from several final columns: combine, an expression of c0, c1, ...
+    # (the columns in order), e.g. a conduction velocity 2 / (c1 - c0) from two activation times.
+    columns: tuple = ()
+    combine: Optional[str] = None
+    combine_code: Any = None
+    label: Optional[str] = None  # what the quantity is, for the tables and plots
 
 
 @dataclass(frozen=True)
@@ -287,7 +293,8 @@ def _scene_probes(scene: Path) -> dict:
 
 
 def _parse_quantity(node: Any, scene: Path) -> Quantity:
-    _check_keys(node, "quantity", ("probe", "kind"), ("field", "column", "time"))
+    _check_keys(node, "quantity", ("probe", "kind"),
+                ("field", "column", "columns", "combine", "label", "time"))
     probe = _string(node["probe"], "quantity.probe")
     kind = node["kind"]
     if kind not in KINDS:
@@ -305,10 +312,12 @@ def _parse_quantity(node: Any, scene: Path) -> Quantity:
         if node.get("column") is not None:
             raise StudyError("quantity.column: not used by a profile (it takes every column "
                              "of 'field')")
-    else:
-        if node.get("column") is None:
+    columns, combine, combine_code = _parse_combination(node, kind)
+    if kind != "profile":
+        if node.get("column") is None and not columns:
             raise StudyError(f"quantity.column: missing (required by kind {kind}), e.g. "
-                             "concentration@p0")
+                             "concentration@p0"
+                             + (" (or 'columns' with 'combine')" if kind == "final" else ""))
         if node.get("time") is not None:
             raise StudyError("quantity.time: only used by a profile")
     when = node.get("time", "last")
@@ -320,7 +329,46 @@ def _parse_quantity(node: Any, scene: Path) -> Quantity:
     column = node.get("column")
     if column is not None:
         column = _string(column, "quantity.column")
-    return Quantity(probe, kind, field_name, column, when)
+    label = node.get("label")
+    if label is not None:
+        label = _string(label, "quantity.label")
+    return Quantity(probe, kind, field_name, column, when, columns, combine, combine_code, label)
+
+
+def _parse_combination(node: dict, kind: str) -> tuple:
+    """(columns, combine text, compiled combine) of a derived final value, or ((), None, None)."""
+    columns, combine = node.get("columns"), node.get("combine")
+    if columns is None and combine is None:
+        return (), None, None
+    if kind != "final":
+        given = "columns" if columns is not None else "combine"
+        raise StudyError(f"quantity.{given}: only used by kind final (a value derived from "
+                         "several final columns)")
+    if node.get("column") is not None:
+        raise StudyError("quantity.column: give either 'column' or 'columns' with 'combine', "
+                         "not both")
+    if columns is None:
+        raise StudyError("quantity.columns: missing (required by 'combine'), e.g. "
+                         '["activation_time@p0", "activation_time@p1"]')
+    if combine is None:
+        raise StudyError("quantity.combine: missing (required by 'columns'), an expression of "
+                         "c0, c1, ... e.g. 2 / (c1 - c0)")
+    if not isinstance(columns, list) or not columns:
+        raise StudyError("quantity.columns: expected a non-empty list of probe columns")
+    names = tuple(_string(c, f"quantity.columns[{i}]") for i, c in enumerate(columns))
+    if len(set(names)) != len(names):
+        raise StudyError("quantity.columns: a column is listed twice")
+    text = (str(combine) if isinstance(combine, (int, float)) and not isinstance(combine, bool)
+            else _string(combine, "quantity.combine"))
+    known = {f"c{i}" for i in range(len(names))}
+    code = compile_expression(text, "quantity.combine", known)
+    used = {n.id for n in ast.walk(ast.parse(text.strip(), mode="eval"))
+            if isinstance(n, ast.Name)}
+    unused = sorted(known - used, key=lambda n: int(n[1:]))
+    if unused:
+        raise StudyError(f"quantity.combine: does not use {', '.join(unused)} (a listed column "
+                         "that the expression ignores is probably a mistake)")
+    return names, text, code
 
 
 def _parse_reference(node: Any, base: Path, quantity: Quantity, norm: str) -> Reference:
@@ -620,6 +668,8 @@ def extract_sample(quantity: Quantity, out_dir: Path) -> Sample:
     times, columns, values, coordinates = read_probe(out_dir, quantity.probe)
     if quantity.kind == "profile":
         return _profile_sample(quantity, times, columns, values, coordinates)
+    if quantity.combine is not None:
+        return _combined_sample(quantity, times, columns, values)
     if quantity.column not in columns:
         shown = ", ".join(columns[:6]) + (", ..." if len(columns) > 6 else "")
         raise ComparisonError(f"probe '{quantity.probe}' has no column '{quantity.column}' "
@@ -635,6 +685,31 @@ def extract_sample(quantity: Quantity, out_dir: Path) -> Sample:
                  "z": np.full_like(times, xyz[2]), "t": times,
                  "distance": np.full_like(times, distance)}
     return Sample(series, variables, times, "time", _field_of(quantity.column))
+
+
+def _combined_sample(quantity: Quantity, times, columns, values) -> Sample:
+    """A final value derived from the last row of several columns (no single position: x, y, z
+    and distance are NaN)."""
+    missing = [c for c in quantity.columns if c not in columns]
+    if missing:
+        shown = ", ".join(columns[:6]) + (", ..." if len(columns) > 6 else "")
+        raise ComparisonError(f"probe '{quantity.probe}' has no column '{missing[0]}' "
+                              f"(it has {shown})")
+    namespace = dict(expression_functions())
+    namespace.update({f"c{i}": float(values[-1, columns.index(c)])
+                      for i, c in enumerate(quantity.columns)})
+    with np.errstate(all="ignore"):
+        try:
+            value = float(eval(quantity.combine_code, {"__builtins__": {}}, namespace))  # noqa: S307
+        except ArithmeticError:  # 1 / 0 of Python floats, overflow
+            value = math.nan
+    if not math.isfinite(value):
+        shown = ", ".join(f"c{i} = {namespace[f'c{i}']:g}" for i in range(len(quantity.columns)))
+        raise ComparisonError(f"combine '{quantity.combine}' is not finite ({shown})")
+    t = times[-1:]
+    nan = np.full_like(t, math.nan)
+    variables = {"x": nan, "y": nan.copy(), "z": nan.copy(), "t": t, "distance": nan.copy()}
+    return Sample(np.array([value]), variables, t, "time", quantity_name(quantity))
 
 
 def _profile_sample(quantity: Quantity, times, columns, values, coordinates) -> Sample:
@@ -769,13 +844,29 @@ def write_table(path: Path, study: Study, results: list) -> None:
     path.write_text(caption + markdown_table(results))
 
 
+def quantity_name(quantity: Quantity) -> str:
+    """A short name of the quantity for axis labels."""
+    if quantity.label:
+        return quantity.label
+    if quantity.combine is not None:
+        return quantity.combine
+    if quantity.column is not None:
+        return _field_of(quantity.column)
+    return quantity.field or "value"
+
+
 def quantity_text(quantity: Quantity) -> str:
+    if quantity.combine is not None:
+        given = ", ".join(f"c{i} = {c}" for i, c in enumerate(quantity.columns))
+        name = f"{quantity.label} = " if quantity.label else ""
+        return f"{name}{quantity.combine} of the final values {given}"
     if quantity.kind == "profile":
         when = "last row" if quantity.time == "last" else f"row nearest t = {quantity.time:g}"
         return f"profile, {when}"
+    name = f"{quantity.label}: " if quantity.label else ""
     if quantity.kind == "time_series":
-        return f"time series of {quantity.column}"
-    return f"final value of {quantity.column}"
+        return f"{name}time series of {quantity.column}"
+    return f"{name}final value of {quantity.column}"
 
 
 @dataclass

@@ -137,7 +137,7 @@ def reference_lines(study: studies.Study, doc_dir: Path) -> list:
         lines.append(f"Reference (data): {_link(reference.csv_file, doc_dir)}, interpolated "
                      f"along {reference.along}.")
     else:
-        lines.append(f"Reference (a number): {reference.value:g}.")
+        lines.append(f"Reference (a number): {reference.value:.10g}.")
     lines += ["", f"Source: {reference.source}."]
     return lines
 
@@ -148,10 +148,12 @@ def study_section(number: int, run: studies.StudyRun, doc_dir: Path, image: Path
     lines += setup_lines(study, run, doc_dir)
     lines += ["", "### Reference", ""]
     lines += reference_lines(study, doc_dir)
+    right = ("every point's value against its particle count, with the reference"
+             if study.quantity.kind == "final"
+             else "the reference over the simulated curve of the best point")
     lines += ["", "### Results", "",
               f"Bold: the lowest error. Study run time {run.seconds:.1f} s. "
-              "Left: error against wall time per run; right: the reference over the simulated "
-              "curve of the best point.", ""]
+              f"Left: error against wall time per run; right: {right}.", ""]
     lines.append(studies.markdown_table(run.results).rstrip("\n"))
     lines += ["", f"![{study.title}]({os.path.relpath(image, doc_dir)})", ""]
     return lines
