@@ -61,6 +61,27 @@ double anisotropic_exact(double x, double y, double t) {
          std::exp(-0.5 * r.dot(sigma.inverse() * r));
 }
 
+double isotropic_gaussian_exact(double x, double y, double t) {
+  // Seed 001 eq. (52) in 2D: exp(-r^2/(4 d t0)) spreads to t0/(t + t0) exp(-r^2/(4 d (t + t0))),
+  // here with 4 d t0 = 2 s0^2 (s0 = 0.05) and d = 1e-4.
+  const double d = 1e-4, t0 = 2.0 * 0.05 * 0.05 / (4.0 * d);
+  const double r2 = (x - 0.5) * (x - 0.5) + (y - 0.5) * (y - 0.5);
+  return t0 / (t + t0) * std::exp(-r2 / (4.0 * d * (t + t0)));
+}
+
+TEST(DiffusionValidation, IsotropicGaussianErrorIsSmallAndFallsWithResolution) {
+  const auto scene = example("diffusion_2d_anisotropic.yaml");
+  const std::string iso = "modules[0].diffusion.anisotropy.across=1.0e-4";  // along = across
+  const double coarse = relative_l2_error(scene, {iso, "modules[0].diffusion.body.spacing=0.02"},
+                                          isotropic_gaussian_exact);
+  const double fine = relative_l2_error(scene, {iso, "modules[0].diffusion.body.spacing=0.01"},
+                                        isotropic_gaussian_exact);
+  std::cout << "isotropic Gaussian relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine
+            << "\n";
+  EXPECT_LT(fine, 0.002);
+  EXPECT_LT(fine, 0.3 * coarse);
+}
+
 TEST(DiffusionValidation, TopHatErrorIsSmallAndFallsWithResolution) {
   const auto scene = example("diffusion_1d_tophat.yaml");
   const double coarse =
