@@ -3,6 +3,7 @@
 #include "active_stress/active_stress_module.hpp"
 #include "diffusion/diffusion_module.hpp"
 #include "monodomain/monodomain_module.hpp"
+#include "solid_tlsph/solid_module.hpp"
 
 namespace cosph {
 
@@ -12,6 +13,7 @@ const ModuleRegistry& builtin_modules() {
     r.add("diffusion", make_diffusion_module);
     r.add("monodomain", make_monodomain_module);
     r.add("active_stress", make_active_stress_module);
+    r.add("solid", make_solid_module);
     return r;
   }();
   return registry;

@@ -92,6 +92,10 @@ class Module {
   virtual void save(StateRecord& state) const = 0;
   virtual void load(const StateRecord& state) = 0;
 
+  // Called before the driver writes output or samples probes: a module computes its derived
+  // output fields here (stresses, strains) instead of at every step.
+  virtual void prepare_output() {}
+
   // Bodies for output and probes; particle counts for the summary.
   virtual void bodies(BodyViews& views) const = 0;
   virtual std::size_t particle_count() const = 0;

@@ -110,7 +110,17 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
       for (std::size_t k = 0; k < names.size(); ++k)
         check_field(names[k],
                     path + (line ? ".line" : ".points") + ".fields[" + std::to_string(k) + "]");
-      auto entry = std::make_unique<PointProbeEntry<D>>(body, PointProbe<D>(points, names));
+      ProbeOptions options;
+      options.linear = spec.interpolation() == "linear";
+      if (spec.configuration() == "reference") {
+        options.position_field = "reference_position";
+        if (!particles.has(options.position_field))
+          throw ConfigError(
+              path + ".configuration",
+              "body '" + particles.name() + "' does not move: it has no reference configuration");
+      }
+      auto entry =
+          std::make_unique<PointProbeEntry<D>>(body, PointProbe<D>(points, names, {}, options));
       entry->columns = entry->probe.columns();
       for (const auto& p : points) entry->points.emplace_back(p.data(), p.data() + D);
       return entry;

@@ -201,9 +201,19 @@ RunSummary Simulation::run() {
   const bool vtp = files && s.output().vtp();
   const std::string fp = fingerprint(s);
 
+  // Derived output fields are computed once per output time, only when something is written.
+  double prepared_time = -INFINITY;
+  long long prepared_steps = -1;
+  auto prepare_output = [&](double t) {
+    if (t == prepared_time && static_cast<long long>(I.steps) == prepared_steps) return;
+    for (auto& m : modules_) m->prepare_output();
+    prepared_time = t;
+    prepared_steps = static_cast<long long>(I.steps);
+  };
   auto write_output = [&](double t) {
     if (!vtp) return;
     const auto start = Clock::now();
+    prepare_output(t);
     std::size_t body = 0;
     auto write_body = [&](const auto& view) {
       if (I.pvds.size() <= body) {
@@ -227,6 +237,7 @@ RunSummary Simulation::run() {
   };
   auto sample_probe = [&](std::size_t k, double t) {
     const auto start = Clock::now();
+    prepare_output(t);
     I.probes->sample(k, t);
     I.output_seconds += seconds_since(start);
   };

@@ -1,5 +1,6 @@
 #include "io/probes.hpp"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -48,8 +49,11 @@ FieldView resolve(const ParticleSet<D>& particles, const std::string& spec) {
 
 template <int D>
 PointProbe<D>::PointProbe(std::vector<Vec<D>> points, std::vector<std::string> fields,
-                          std::vector<std::string> labels)
-    : points_(std::move(points)), fields_(std::move(fields)), labels_(std::move(labels)) {
+                          std::vector<std::string> labels, ProbeOptions options)
+    : points_(std::move(points)),
+      fields_(std::move(fields)),
+      labels_(std::move(labels)),
+      options_(std::move(options)) {
   if (labels_.empty())
     for (std::size_t p = 0; p < points_.size(); ++p) {
       // Appended rather than "p" + to_string(p), which trips GCC 12's false -Wrestrict
@@ -89,7 +93,7 @@ std::vector<double> PointProbe<D>::sample(const ParticleSet<D>& particles,
     throw std::invalid_argument("point probe: " + std::to_string(volumes.size()) + " volumes for " +
                                 std::to_string(particles.size()) + " particles of body '" +
                                 particles.name() + "'");
-  const auto& x = required_vector(particles, "position", "point probes");
+  const auto& x = required_vector(particles, options_.position_field, "point probes");
   std::vector<FieldView> views;
   for (const auto& f : fields_) views.push_back(resolve(particles, f));
 
@@ -114,16 +118,41 @@ std::vector<double> PointProbe<D>::sample(const ParticleSet<D>& particles,
     if (!point.allFinite()) return;
     for (int a = 0; a < D; ++a)
       if (!domain.periodic[a] && (point[a] < lo[a] - support || point[a] > hi[a] + support)) return;
-    double weight = 0.0;
-    std::vector<double> sum(nf, 0.0);
+    // Moments of the weighted linear fit: M = sum w [1, d^T; d, d d^T], r_f = sum w f [1; d]
+    // with d = x_j - x (only the first row and column when Shepard is asked for).
+    using Moment = Eigen::Matrix<double, D + 1, D + 1>;
+    using Basis = Eigen::Matrix<double, D + 1, 1>;
+    Moment M = Moment::Zero();
+    std::vector<Basis> rhs(nf, Basis::Zero());
     cells.for_each_neighbour(point, support, kNone, [&](Index j) {
-      const double w = volumes[j] * kernel.value(domain.displacement(point, x[j]).norm());
-      weight += w;
+      const Vec<D> d = domain.displacement(x[j], point);
+      const double w = volumes[j] * kernel.value(d.norm());
+      Basis basis;
+      basis << 1.0, d;
+      if (options_.linear)
+        M += w * basis * basis.transpose();
+      else
+        M(0, 0) += w;
       for (std::size_t f = 0; f < nf; ++f)
-        sum[f] += w * views[f].data[j * views[f].stride + views[f].component];
+        rhs[f] += (w * views[f].data[j * views[f].stride + views[f].component]) * basis;
     });
-    if (weight == 0.0) return;  // NaN stays: nothing (of non-zero volume) within the support
-    for (std::size_t f = 0; f < nf; ++f) values[f * np + p] = sum[f] / weight;
+    if (M(0, 0) == 0.0) return;  // NaN stays: nothing (of non-zero volume) within the support
+    if (options_.linear) {
+      // Scaled so that the condition number reflects geometry, not units.
+      const double h = kernel.smoothing_length();
+      Basis scale = Basis::Constant(1.0 / h);
+      scale[0] = 1.0;
+      const Moment S = scale.asDiagonal() * M * scale.asDiagonal();
+      const Eigen::FullPivLU<Moment> lu(S);
+      if (lu.rank() == D + 1 && lu.rcond() > 1e-6) {
+        for (std::size_t f = 0; f < nf; ++f) {
+          const Basis c = lu.solve(scale.asDiagonal() * rhs[f]);
+          values[f * np + p] = c[0];  // a = f at the point (scale[0] = 1)
+        }
+        return;
+      }
+    }
+    for (std::size_t f = 0; f < nf; ++f) values[f * np + p] = rhs[f][0] / M(0, 0);
   });
   return values;
 }

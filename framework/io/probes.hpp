@@ -20,6 +20,17 @@ namespace cosph {
 // would be truncated; linear fields are exact where the neighbourhood is symmetric about x.
 // A point with no particle within the support has no value: it yields NaN (CSV writes "nan"),
 // so that a sensor that has run dry shows as a gap in a plot instead of a misleading 0.
+// How a probe finds and weighs the particles around a point.
+struct ProbeOptions {
+  // The vector field holding the positions the points refer to: "position" (current
+  // configuration) or, for material points of a moving body, "reference_position".
+  std::string position_field = "position";
+  // false: Shepard average. true: linear moving least squares, f(x) = a of the weighted fit
+  // f_j ~ a + b . (x_j - x), exact for linear fields also at corners and edges where the average
+  // is biased by the one-sided neighbourhood (falls back to Shepard where the fit is singular).
+  bool linear = false;
+};
+
 template <int D>
 class PointProbe {
  public:
@@ -29,7 +40,7 @@ class PointProbe {
   // the column names, one per point; empty means "p0", "p1", ... Throws std::invalid_argument if
   // the number of labels does not match.
   PointProbe(std::vector<Vec<D>> points, std::vector<std::string> fields,
-             std::vector<std::string> labels = {});
+             std::vector<std::string> labels = {}, ProbeOptions options = {});
 
   const std::vector<Vec<D>>& points() const { return points_; }
   const std::vector<std::string>& fields() const { return fields_; }
@@ -39,7 +50,7 @@ class PointProbe {
   // of the first field, then all of the second...), in the order of sample()'s values.
   std::vector<std::string> columns() const;
 
-  // Interpolated values in the order of columns(). Positions come from the field "position",
+  // Interpolated values in the order of columns(). Positions come from the options' position field,
   // volumes V_j from `volumes` (one per particle, e.g. m/rho computed by the caller) or from the
   // scalar field `volume_field`. Throws cosph::RuntimeError naming the body and field if a field
   // is missing, std::invalid_argument if the kernel's dimension is not D or `volumes` has the
@@ -53,6 +64,7 @@ class PointProbe {
   std::vector<Vec<D>> points_;
   std::vector<std::string> fields_;
   std::vector<std::string> labels_;
+  ProbeOptions options_;
 };
 
 extern template class PointProbe<2>;

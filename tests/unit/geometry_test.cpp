@@ -393,7 +393,7 @@ TEST_F(PointCloudCsv, EveryErrorNamesTheFileAndTheLine) {
   EXPECT_PRED2(has_substr, error_of("too_few", "x,y,z,volume,id\n1,2,3,4,5\n1,2,3,4\n"),
                ":3: expected 5 comma-separated fields (as in the header), found 4");
   EXPECT_PRED2(has_substr, error_of("too_many", "x,y,z,volume\n1,2,3,4,5\n"), ":2: expected 4");
-  EXPECT_PRED2(has_substr, error_of("header_only", "x,y,z,volume\n"), ": no particles");
+  EXPECT_PRED2(has_substr, error_of("header_only", "x,y,z,volume\n"), ": no data");
   EXPECT_PRED2(has_substr, error_of("no_header", "# nothing\n\n"), ": no header line");
 
   const std::string absent = "/nonexistent_dir_cosph/points.csv";

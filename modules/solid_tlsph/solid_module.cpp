@@ -1,0 +1,601 @@
+#include "solid_tlsph/solid_module.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/parallel.hpp"
+#include "driver/static_body_module.hpp"
+#include "geometry/regions.hpp"
+#include "geometry/surface.hpp"
+#include "solid_tlsph/fibre_frames.hpp"
+#include "solid_tlsph/material_model.hpp"
+#include "solid_tlsph/tlsph_operators.hpp"
+
+namespace cosph {
+namespace {
+
+const std::vector<std::string> kSpaceTime = {"x", "y", "z", "t"};
+
+template <int D>
+class SolidModule final : public StaticBodyModule<D> {
+  using Base = StaticBodyModule<D>;
+  using Base::kernel_;
+  using Base::key_;
+  using Base::name_;
+  using Base::particles_;
+  using Base::steps_;
+  using Base::time_;
+
+ public:
+  SolidModule(const proto::ModuleSpec& spec, const ModuleContext& context)
+      : Base(spec, context, "solid", spec.solid().body()),
+        spec_(spec.solid()),
+        material_(spec_.material(), key_ + ".material") {
+    if (spec_.has_active_tension())
+      active_tension_ = parse(spec_.active_tension(), key_ + ".active_tension");
+    for (int a = 0; a < spec_.initial_velocity_size(); ++a)
+      initial_velocity_.push_back(
+          parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));
+  }
+
+  ModuleInfo info() const override {
+    ModuleInfo info;
+    info.type = "solid";
+    info.name = name_;
+    info.writes = {{"interface", {"position", "normal", "volume", "velocity", "acceleration"}}};
+    info.reads = {{"external_force", {"force"}}, {"active_stress", {"active_stress"}}};
+    auto& f = info.active_features;
+    f.push_back("material " + material_.name());
+    f.push_back("total-Lagrangian SPH, kernel " + kernel_name(kernel_.type()) +
+                ", corrected gradients");
+    f.push_back(spec_.integrator() == "rk4" ? "RK4 integrator" : "position Verlet integrator");
+    if (spec_.has_artificial_viscosity()) f.push_back("artificial viscosity");
+    if (spec_.has_hourglass_control()) f.push_back("hourglass control");
+    if (spec_.damping() > 0.0) f.push_back("mass-proportional damping");
+    if (spec_.load_ramp_time() > 0.0) f.push_back("load ramp");
+    if (spec_.body_force_size() > 0) f.push_back("body force");
+    if (!constraints_.empty() || spec_.constraints_size() > 0) f.push_back("constraints");
+    if (spec_.pressures_size() > 0) f.push_back("follower pressure (Nanson)");
+    if (spec_.has_active_tension()) f.push_back("prescribed active tension");
+    if (has_frames()) f.push_back("fibre frames");
+    for (const auto& o : spec_.outputs()) f.push_back("output " + o);
+    return info;
+  }
+
+  void initialize() override {
+    Base::build_body();
+    const std::size_t n = particles_.size();
+    const auto& volume = particles_.scalar("volume");
+    X_ = particles_.vector("position");
+    particles_.add_vector("reference_position");
+    particles_.vector("reference_position") = X_;
+    const FieldFlags state{.output = true, .checkpoint = true, .exchange = true};
+    particles_.add_vector("displacement", state);
+    auto& v = particles_.add_vector("velocity", state);
+    particles_.add_vector("acceleration", {.exchange = true});
+    auto& mass = particles_.add_scalar("mass");
+    auto& J = particles_.add_scalar("J", {.output = true});
+    std::fill(J.begin(), J.end(), 1.0);
+    for (std::size_t i = 0; i < n; ++i) mass[i] = material_.density() * volume[i];
+    for (const auto& o : spec_.outputs()) {
+      if (o == "von_mises") particles_.add_scalar("von_mises", {.output = true});
+      if (o == "strain_energy") particles_.add_scalar("strain_energy", {.output = true});
+      if (o == "fibre_strain") particles_.add_vector("fibre_strain", {.output = true});
+      if (o == "stress") particles_.add_matrix("stress", {.output = true});
+    }
+    // T_a per particle: prescribed here, or added when a coupler first writes the port.
+    if (spec_.has_active_tension())
+      active_ = &particles_.add_scalar("active_tension", {.output = true});
+
+    if (has_frames()) {
+      frames_ = build_fibre_frames<D>(spec_.fibres(), X_, spec_.body().spacing(), key_ + ".fibres",
+                                      Base::scene_directory_);
+    }
+    try {
+      pairs_ = build_reference_pairs<D>(X_, volume, kernel_, spec_.has_hourglass_control());
+    } catch (const RuntimeError& e) {
+      throw RuntimeError("module '" + name_ + "': " + e.what());
+    }
+    F_.assign(n, Mat<D>::Identity());
+    T_.assign(n, Mat<D>::Zero());
+    if (spec_.has_artificial_viscosity()) {
+      G_.assign(n, Mat<D>::Zero());
+      density_.assign(n, material_.density());
+    }
+    x_ = X_;
+
+    build_constraints();
+    build_pressures();
+    if (spec_.body_force_size() > 0) body_force_ = to_vec<D>(spec_.body_force());
+
+    for (std::size_t i = 0; i < n && !initial_velocity_.empty(); ++i) {
+      const auto p = Base::space_time(X_[i], 0.0);
+      for (int a = 0; a < D; ++a) v[i][a] = initial_velocity_[a].evaluate(p);
+    }
+    auto& u = particles_.vector("displacement");
+    apply_constraints(0.0, u, v);
+    compute_acceleration(0.0, u, v, particles_.vector("acceleration"));
+    prepare_output();
+  }
+
+  double max_dt() const override {
+    if (spec_.has_time_step()) return spec_.time_step();
+    const auto& v = particles_.vector("velocity");
+    const auto& a = particles_.vector("acceleration");
+    double v_max = 0.0, a_max = 0.0;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      v_max = std::max(v_max, v[i].norm());
+      a_max = std::max(a_max, a[i].norm());
+    }
+    // Seed 001 eq. 42; the acceleration bound keeps a particle from moving more than about h in
+    // a step under a sudden load.
+    const double h = kernel_.smoothing_length();
+    double dt = h / (material_.wave_speed() + v_max);
+    if (a_max > 0.0) dt = std::min(dt, std::sqrt(h / a_max));
+    return spec_.time_step_factor() * dt;
+  }
+
+  void advance(double dt) override {
+    if (spec_.integrator() == "rk4")
+      advance_rk4(dt);
+    else
+      advance_verlet(dt);
+    time_ += dt;
+    ++steps_;
+  }
+
+  void prepare_output() override {
+    const auto& u = particles_.vector("displacement");
+    deformation_gradients<D>(pairs_, u, F_);
+    auto& J = particles_.scalar("J");
+    const bool vm = particles_.has("von_mises"), energy = particles_.has("strain_energy"),
+               fibre = particles_.has("fibre_strain"), stress = particles_.has("stress");
+    parallel_for_each_index(u.size(), [&](std::size_t i) {
+      J[i] = F_[i].determinant();
+      if (!(vm || stress || energy || fibre)) return;
+      const Mat<D> frame = has_frames() ? frames_[i] : Mat<D>::Identity();
+      if (vm || stress) {
+        const Mat<D> sigma = first_piola(i, F_[i], frame) * F_[i].transpose() / J[i];
+        if (stress) particles_.matrix("stress")[i] = sigma;
+        if (vm) particles_.scalar("von_mises")[i] = von_mises(sigma);
+      }
+      if (energy) particles_.scalar("strain_energy")[i] = material_.energy(F_[i], frame);
+      if (fibre) {
+        const Mat<D> E = 0.5 * (F_[i].transpose() * F_[i] - Mat<D>::Identity());
+        const Mat<D> local = frame.transpose() * E * frame;
+        particles_.vector("fibre_strain")[i] = local.diagonal();
+      }
+    });
+  }
+
+  void write(const std::string& port, FieldBuffer& out) const override {
+    if (port != "interface")
+      throw RuntimeError("module '" + name_ + "' writes only the port 'interface'");
+    const Surface<D>& s = surface();
+    const auto& x = particles_.vector("position");
+    const auto& v = particles_.vector("velocity");
+    const auto& a = particles_.vector("acceleration");
+    const auto& V = particles_.scalar("volume");
+    out.points = s.particles.size();
+    out.arrays.clear();
+    auto& position = out.arrays["position"];
+    auto& normal = out.arrays["normal"];
+    auto& volume = out.arrays["volume"];
+    auto& velocity = out.arrays["velocity"];
+    auto& acceleration = out.arrays["acceleration"];
+    position.components = normal.components = velocity.components = acceleration.components = D;
+    for (std::size_t k = 0; k < s.particles.size(); ++k) {
+      const Index i = s.particles[k];
+      // Current normal by Nanson: n ~ F^-T N.
+      const Vec<D> n = (F_[i].inverse().transpose() * s.normals[k]).normalized();
+      volume.values.push_back(V[i]);
+      for (int c = 0; c < D; ++c) {
+        position.values.push_back(x[i][c]);
+        normal.values.push_back(n[c]);
+        velocity.values.push_back(v[i][c]);
+        acceleration.values.push_back(a[i][c]);
+      }
+    }
+  }
+
+  void read(const std::string& port, const FieldBuffer& in) override {
+    if (port == "external_force") {
+      auto it = in.arrays.find("force");
+      const std::size_t n = particles_.size(), m = surface().particles.size();
+      if (it == in.arrays.end() || it->second.components != D || (in.points != n && in.points != m))
+        throw RuntimeError("module '" + name_ + "': port 'external_force' needs 'force' with " +
+                           std::to_string(D) + " components per particle (" + std::to_string(n) +
+                           ") or per interface particle (" + std::to_string(m) + ")");
+      external_force_.assign(n, Vec<D>::Zero());
+      for (std::size_t k = 0; k < in.points; ++k) {
+        const std::size_t i = in.points == n ? k : surface().particles[k];
+        for (int c = 0; c < D; ++c) external_force_[i][c] = it->second.values[k * D + c];
+      }
+      return;
+    }
+    if (port == "active_stress") {
+      if (spec_.has_active_tension())
+        throw RuntimeError("module '" + name_ +
+                           "': its active tension is prescribed by the scene; it reads no port");
+      if (!particles_.has("active_tension")) {
+        active_ = &particles_.add_scalar("active_tension", {.output = true, .checkpoint = true});
+        if (!has_frames())
+          frames_ = build_fibre_frames<D>(spec_.fibres(), X_, spec_.body().spacing(),
+                                          key_ + ".fibres", Base::scene_directory_);
+      }
+      Base::read_scalar_port(port, "active_tension", in);
+      return;
+    }
+    throw RuntimeError("module '" + name_ + "' has no port '" + port +
+                       "' (it reads 'external_force' and 'active_stress')");
+  }
+
+  void save(StateRecord& state) const override {
+    for (const char* f : {"displacement", "velocity", "acceleration"}) {
+      const auto raw = particles_.raw(f);
+      state.arrays[f].assign(raw.begin(), raw.end());
+    }
+    if (particles_.has("active_tension"))
+      state.arrays["active_tension"] = particles_.scalar("active_tension");
+    state.scalars["time"] = time_;
+    state.integers["steps"] = steps_;
+  }
+
+  void load(const StateRecord& state) override {
+    for (const char* f : {"displacement", "velocity", "acceleration"}) {
+      auto it = state.arrays.find(f);
+      auto raw = particles_.raw(f);
+      if (it == state.arrays.end() || it->second.size() != raw.size())
+        throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
+                           std::to_string(raw.size()) + " values of '" + f + "'");
+      std::copy(it->second.begin(), it->second.end(), raw.begin());
+    }
+    auto it = state.arrays.find("active_tension");
+    if (it != state.arrays.end()) {
+      if (!particles_.has("active_tension"))
+        active_ = &particles_.add_scalar("active_tension", {.output = true, .checkpoint = true});
+      particles_.scalar("active_tension") = it->second;
+    }
+    time_ = state.scalars.at("time");
+    steps_ = state.integers.at("steps");
+    const auto& u = particles_.vector("displacement");
+    auto& x = particles_.vector("position");
+    for (std::size_t i = 0; i < u.size(); ++i) x[i] = X_[i] + u[i];
+    prepare_output();
+  }
+
+  std::optional<HealthProblem> check_health() const override {
+    // J from the current displacements (the step's own F is the mid-step one).
+    std::vector<Mat<D>> F(F_.size());
+    deformation_gradients<D>(pairs_, particles_.vector("displacement"), F);
+    for (std::size_t i = 0; i < F.size(); ++i) {
+      const double J = F[i].determinant();
+      if (!(J > 0.0))
+        return HealthProblem{"J", static_cast<long long>(i), J,
+                             "> 0 (a particle's neighbourhood is inverted: tangled particles)"};
+    }
+    return std::nullopt;
+  }
+
+ private:
+  enum class ConstraintKind { Clamp, Fixed, Displacement, Velocity };
+  struct Constraint {
+    ConstraintKind kind = ConstraintKind::Clamp;
+    std::vector<Index> particles;
+    std::array<bool, D> components{};
+    std::vector<Expression> values;
+  };
+  struct Pressure {
+    std::vector<Index> particles;
+    std::vector<Vec<D>> normals;  // reference outward unit normal N
+    std::vector<double> areas;    // reference area dA
+    Expression value;
+  };
+
+  static Expression parse(const std::string& text, const std::string& key) {
+    return Base::parse_expression(text, kSpaceTime, key);
+  }
+
+  bool has_frames() const {
+    return material_.anisotropic() || spec_.has_active_tension() || !frames_.empty() ||
+           std::find(spec_.outputs().begin(), spec_.outputs().end(), "fibre_strain") !=
+               spec_.outputs().end();
+  }
+
+  double load_factor(double t) const {
+    const double ramp = spec_.load_ramp_time();
+    return ramp > 0.0 ? std::min(t / ramp, 1.0) : 1.0;
+  }
+
+  static double von_mises(const Mat<D>& s) {
+    Mat<3> full = Mat<3>::Zero();
+    full.template topLeftCorner<D, D>() = s;
+    const Mat<3> dev = full - full.trace() / 3.0 * Mat<3>::Identity();
+    return std::sqrt(1.5 * (dev.array() * dev.array()).sum());
+  }
+
+  // P of particle i: the law plus the active stress T_a F f0 (x) f0.
+  Mat<D> first_piola(std::size_t i, const Mat<D>& F, const Mat<D>& frame) const {
+    Mat<D> P = material_.stress(F, frame);
+    if (active_ && (*active_)[i] != 0.0) {
+      const Vec<D> f0 = frame.col(0);
+      P.noalias() += (*active_)[i] * (F * f0) * f0.transpose();
+    }
+    return P;
+  }
+
+  const Surface<D>& surface() const {
+    if (!surface_)
+      surface_ = detect_surface<D>(X_, particles_.scalar("volume"), spec_.body().spacing());
+    return *surface_;
+  }
+
+  void build_constraints() {
+    for (int k = 0; k < spec_.constraints_size(); ++k) {
+      const auto& c = spec_.constraints(k);
+      const std::string path = key_ + ".constraints[" + std::to_string(k) + "]";
+      auto shape = build_shape<D>(c.region().shape(), path + ".region.shape");
+      Constraint constraint;
+      constraint.particles = select_region<D>(X_, *shape);
+      if (constraint.particles.empty())
+        throw ConfigError(path + ".region", "the region contains no particle");
+      switch (c.kind_case()) {
+        case proto::Constraint::kClamp:
+          constraint.kind = ConstraintKind::Clamp;
+          break;
+        case proto::Constraint::kFixed:
+          constraint.kind = ConstraintKind::Fixed;
+          for (int a : c.fixed().components()) {
+            if (a < 0 || a >= D)
+              throw ConfigError(path + ".fixed.components", "component " + std::to_string(a) +
+                                                                " does not exist in " +
+                                                                std::to_string(D) + "D");
+            constraint.components[a] = true;
+          }
+          break;
+        case proto::Constraint::kDisplacement:
+        case proto::Constraint::kVelocity: {
+          const bool displacement = c.has_displacement();
+          constraint.kind = displacement ? ConstraintKind::Displacement : ConstraintKind::Velocity;
+          const auto& m = displacement ? c.displacement() : c.velocity();
+          for (int a = 0; a < m.values_size(); ++a)
+            constraint.values.push_back(
+                parse(m.values(a), path + (displacement ? ".displacement" : ".velocity") +
+                                       ".values[" + std::to_string(a) + "]"));
+          break;
+        }
+        case proto::Constraint::KIND_NOT_SET:
+          throw ConfigError(path, "give one of: clamp, fixed, displacement, velocity");
+      }
+      constraints_.push_back(std::move(constraint));
+    }
+  }
+
+  void build_pressures() {
+    const auto& volume = particles_.scalar("volume");
+    const double spacing = spec_.body().spacing();
+    for (int k = 0; k < spec_.pressures_size(); ++k) {
+      const auto& spec = spec_.pressures(k);
+      const std::string path = key_ + ".pressures[" + std::to_string(k) + "]";
+      auto shape = build_shape<D>(spec.region().shape(), path + ".region.shape");
+      Pressure load;
+      load.value = parse(spec.value(), path + ".value");
+      const Surface<D>& s = surface();
+      const bool given = spec.normal_size() > 0;
+      Vec<D> normal = Vec<D>::Zero();
+      if (given) {
+        normal = to_vec<D>(spec.normal());
+        if (!(normal.norm() > 0.0)) throw ConfigError(path + ".normal", "normal is zero");
+        normal.normalize();
+      }
+      for (std::size_t m = 0; m < s.particles.size(); ++m) {
+        const Index i = s.particles[m];
+        if (!shape->contains(X_[i])) continue;
+        load.particles.push_back(i);
+        load.normals.push_back(given ? normal : s.normals[m]);
+        // A surface particle carries the face area of its volume: dA = V / spacing.
+        load.areas.push_back(volume[i] / spacing);
+      }
+      if (load.particles.empty())
+        throw ConfigError(path + ".region", "the region contains no surface particle");
+      pressures_.push_back(std::move(load));
+    }
+  }
+
+  // Holds constrained particles at time t (before an acceleration is computed from u, v).
+  void apply_constraints(double t, std::vector<Vec<D>>& u, std::vector<Vec<D>>& v) const {
+    for (const auto& c : constraints_)
+      for (Index i : c.particles) switch (c.kind) {
+          case ConstraintKind::Clamp:
+            u[i].setZero();
+            v[i].setZero();
+            break;
+          case ConstraintKind::Fixed:
+            for (int a = 0; a < D; ++a)
+              if (c.components[a]) {
+                u[i][a] = 0.0;
+                v[i][a] = 0.0;
+              }
+            break;
+          case ConstraintKind::Displacement: {
+            const auto p = Base::space_time(X_[i], t);
+            for (int a = 0; a < D; ++a) u[i][a] = c.values[a].evaluate(p);
+            break;
+          }
+          case ConstraintKind::Velocity: {
+            const auto p = Base::space_time(X_[i], t);
+            for (int a = 0; a < D; ++a) v[i][a] = c.values[a].evaluate(p);
+            break;
+          }
+        }
+  }
+
+  // Constrained components carry no acceleration (their motion is prescribed).
+  void constrain_acceleration(std::vector<Vec<D>>& a) const {
+    for (const auto& c : constraints_)
+      for (Index i : c.particles) {
+        if (c.kind == ConstraintKind::Fixed) {
+          for (int d = 0; d < D; ++d)
+            if (c.components[d]) a[i][d] = 0.0;
+        } else {
+          a[i].setZero();
+        }
+      }
+  }
+
+  // a(u, v, t) without damping: stress divergence, artificial viscosity, hourglass control, body
+  // force, follower pressure, external force; constrained components zeroed.
+  void compute_acceleration(double t, const std::vector<Vec<D>>& u, const std::vector<Vec<D>>& v,
+                            std::vector<Vec<D>>& a) {
+    const std::size_t n = u.size();
+    const bool viscosity = spec_.has_artificial_viscosity();
+    const bool hourglass = spec_.has_hourglass_control();
+    update_active_tension(t);
+    deformation_gradients<D>(pairs_, u, F_);
+    parallel_for_each_index(n, [&](std::size_t i) {
+      const Mat<D>& F = F_[i];
+      const Mat<D> frame = frames_.empty() ? Mat<D>::Identity() : frames_[i];
+      T_[i] = first_piola(i, F, frame) * pairs_.correction[i].transpose();
+      x_[i] = X_[i] + u[i];
+      if (viscosity) {
+        const double J = F.determinant();
+        G_[i] = J * F.inverse().transpose() * pairs_.correction[i].transpose();
+        density_[i] = material_.density() / J;
+      }
+    });
+    const double rho0 = material_.density();
+    const Vec<D> gravity = body_force_ * load_factor(t);
+    const ViscosityParameters viscous{spec_.artificial_viscosity().alpha(),
+                                      spec_.artificial_viscosity().beta(), material_.wave_speed(),
+                                      kernel_.smoothing_length()};
+    const double stiffness = spec_.hourglass_control().coefficient() * material_.young_modulus();
+    parallel_for_each_index(n, [&](std::size_t i) {
+      Vec<D> force = pair_stress_divergence<D>(pairs_, T_, i);
+      if (viscosity) force += artificial_viscosity<D>(pairs_, x_, v, density_, G_, viscous, i);
+      if (hourglass) force += hourglass_force<D>(pairs_, X_, x_, F_, stiffness, i);
+      a[i] = force / rho0 + gravity;
+    });
+    const auto& mass = particles_.scalar("mass");
+    const double factor = load_factor(t);
+    for (const auto& load : pressures_)
+      for (std::size_t k = 0; k < load.particles.size(); ++k) {
+        const Index i = load.particles[k];
+        const double p = factor * load.value.evaluate(Base::space_time(X_[i], t));
+        const Mat<D>& F = F_[i];
+        // Nanson: n da = J F^-T N dA; the pressure pushes against the outward normal.
+        a[i] -= (p * F.determinant() * load.areas[k] / mass[i]) *
+                (F.inverse().transpose() * load.normals[k]);
+      }
+    if (!external_force_.empty())
+      for (std::size_t i = 0; i < n; ++i) a[i] += external_force_[i] / mass[i];
+    constrain_acceleration(a);
+  }
+
+  void update_active_tension(double t) {
+    if (!spec_.has_active_tension()) return;
+    auto& T = particles_.scalar("active_tension");
+    parallel_for_each_index(T.size(), [&](std::size_t i) {
+      T[i] = active_tension_.evaluate(Base::space_time(X_[i], t));
+    });
+  }
+
+  // Position Verlet (seed 001 eqs. 47-49): half drift, kick with the mid-step acceleration, half
+  // drift. Damping is implicit in the kick (unconditionally stable).
+  void advance_verlet(double dt) {
+    auto& u = particles_.vector("displacement");
+    auto& v = particles_.vector("velocity");
+    auto& a = particles_.vector("acceleration");
+    auto& x = particles_.vector("position");
+    const double t = time_, half = 0.5 * dt, damping = 1.0 / (1.0 + spec_.damping() * dt);
+    parallel_for_each_index(u.size(), [&](std::size_t i) { u[i] += half * v[i]; });
+    apply_constraints(t + half, u, v);
+    compute_acceleration(t + half, u, v, a);
+    parallel_for_each_index(u.size(), [&](std::size_t i) {
+      v[i] = (v[i] + dt * a[i]) * damping;
+      u[i] += half * v[i];
+    });
+    finish_constraints(t, dt, u, v);
+    parallel_for_each_index(u.size(), [&](std::size_t i) { x[i] = X_[i] + u[i]; });
+  }
+
+  // Classical RK4 on (u, v) (seed 000), damping explicit in the rates.
+  void advance_rk4(double dt) {
+    auto& u = particles_.vector("displacement");
+    auto& v = particles_.vector("velocity");
+    auto& a = particles_.vector("acceleration");
+    auto& x = particles_.vector("position");
+    const std::size_t n = u.size();
+    const double t = time_, zeta = spec_.damping();
+    u0_ = u;
+    v0_ = v;
+    us_ = u;
+    vs_ = v;
+    du_.assign(n, Vec<D>::Zero());
+    dv_.assign(n, Vec<D>::Zero());
+    const double c[4] = {0.0, 0.5, 0.5, 1.0}, w[4] = {1.0 / 6, 2.0 / 6, 2.0 / 6, 1.0 / 6};
+    for (int s = 0; s < 4; ++s) {
+      if (s > 0)
+        parallel_for_each_index(n, [&](std::size_t i) {
+          const Vec<D> rate_u = vs_[i];  // the previous stage's rates: (v_s, a_s)
+          us_[i] = u0_[i] + c[s] * dt * rate_u;
+          vs_[i] = v0_[i] + c[s] * dt * a[i];
+        });
+      apply_constraints(t + c[s] * dt, us_, vs_);
+      compute_acceleration(t + c[s] * dt, us_, vs_, a);
+      parallel_for_each_index(n, [&](std::size_t i) {
+        a[i] -= zeta * vs_[i];
+        du_[i] += w[s] * vs_[i];
+        dv_[i] += w[s] * a[i];
+      });
+    }
+    parallel_for_each_index(n, [&](std::size_t i) {
+      u[i] = u0_[i] + dt * du_[i];
+      v[i] = v0_[i] + dt * dv_[i];
+    });
+    finish_constraints(t, dt, u, v);
+    parallel_for_each_index(n, [&](std::size_t i) { x[i] = X_[i] + u[i]; });
+  }
+
+  // End-of-step constraints: clamps and fixed components stay put, prescribed velocities take
+  // their value at t + dt, prescribed displacements theirs (with the velocity that reaches it).
+  void finish_constraints(double t, double dt, std::vector<Vec<D>>& u, std::vector<Vec<D>>& v) {
+    apply_constraints(t + dt, u, v);
+    for (const auto& c : constraints_) {
+      if (c.kind != ConstraintKind::Displacement) continue;
+      for (Index i : c.particles) {
+        const auto before = Base::space_time(X_[i], t), after = Base::space_time(X_[i], t + dt);
+        for (int a = 0; a < D; ++a)
+          v[i][a] = (c.values[a].evaluate(after) - c.values[a].evaluate(before)) / dt;
+      }
+    }
+  }
+
+  proto::SolidSpec spec_;
+  MaterialModel<D> material_;
+  Expression active_tension_;
+  std::vector<Expression> initial_velocity_;
+  std::vector<Vec<D>> X_, x_;
+  std::vector<Mat<D>> frames_, F_, T_, G_;
+  std::vector<double> density_;
+  const std::vector<double>* active_ = nullptr;  // T_a per particle, when there is one
+  ReferencePairs<D> pairs_;
+  std::vector<Constraint> constraints_;
+  std::vector<Pressure> pressures_;
+  Vec<D> body_force_ = Vec<D>::Zero();
+  std::vector<Vec<D>> external_force_;
+  mutable std::optional<Surface<D>> surface_;
+  std::vector<Vec<D>> u0_, v0_, us_, vs_, du_, dv_;  // RK4 stages (RK4 only)
+};
+
+}  // namespace
+
+std::unique_ptr<Module> make_solid_module(const proto::ModuleSpec& spec,
+                                          const ModuleContext& context) {
+  if (context.scene->dimension() == 2) return std::make_unique<SolidModule<2>>(spec, context);
+  return std::make_unique<SolidModule<3>>(spec, context);
+}
+
+}  // namespace cosph
