@@ -95,7 +95,12 @@ std::vector<Mat<D>> frames_from_csv(const std::string& file, const std::vector<V
   } catch (const RuntimeError& e) {
     throw ConfigError(key, e.what());
   }
-  const bool sheets = !table.values[2 * D].empty();
+  int sheet_columns = 0;
+  for (int a = 0; a < D; ++a) sheet_columns += !table.values[2 * D + a].empty();
+  if (sheet_columns != 0 && sheet_columns != D)
+    throw ConfigError(key, file + ": give all of the sheet columns (sx, sy" +
+                               std::string(D == 3 ? ", sz" : "") + ") or none");
+  const bool sheets = sheet_columns == D;
   std::vector<Vec<D>> points(table.rows()), fibres(table.rows()), sheet(table.rows());
   for (std::size_t r = 0; r < table.rows(); ++r)
     for (int a = 0; a < D; ++a) {

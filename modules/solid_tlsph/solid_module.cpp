@@ -90,7 +90,9 @@ class SolidModule final : public StaticBodyModule<D> {
     if (spec_.has_active_tension())
       active_ = &particles_.add_scalar("active_tension", {.output = true});
 
-    if (has_frames()) {
+    // A fibre spec is checked even when nothing needs it yet (a coupler may send active stress
+    // later): its errors belong at start-up, with the scene line.
+    if (has_frames() || spec_.has_fibres()) {
       frames_ = build_fibre_frames<D>(spec_.fibres(), X_, spec_.body().spacing(), key_ + ".fibres",
                                       Base::scene_directory_);
     }
@@ -299,8 +301,7 @@ class SolidModule final : public StaticBodyModule<D> {
   };
   struct Pressure {
     std::vector<Index> particles;
-    std::vector<Vec<D>> normals;  // reference outward unit normal N
-    std::vector<double> areas;    // reference area dA
+    std::vector<Vec<D>> areas;  // reference outward area vector N dA
     Expression value;
   };
 
@@ -383,6 +384,7 @@ class SolidModule final : public StaticBodyModule<D> {
     }
   }
 
+  // Surface particles of each pressure region, with their reference area vectors N dA.
   void build_pressures() {
     const auto& volume = particles_.scalar("volume");
     const double spacing = spec_.body().spacing();
@@ -403,10 +405,10 @@ class SolidModule final : public StaticBodyModule<D> {
       for (std::size_t m = 0; m < s.particles.size(); ++m) {
         const Index i = s.particles[m];
         if (!shape->contains(X_[i])) continue;
+        // A surface particle carries the face area of its volume, dA = V / spacing, along its
+        // outward normal (the given one for a flat face).
         load.particles.push_back(i);
-        load.normals.push_back(given ? normal : s.normals[m]);
-        // A surface particle carries the face area of its volume: dA = V / spacing.
-        load.areas.push_back(volume[i] / spacing);
+        load.areas.push_back((volume[i] / spacing) * (given ? normal : s.normals[m]));
       }
       if (load.particles.empty())
         throw ConfigError(path + ".region", "the region contains no surface particle");
@@ -495,8 +497,7 @@ class SolidModule final : public StaticBodyModule<D> {
         const double p = factor * load.value.evaluate(Base::space_time(X_[i], t));
         const Mat<D>& F = F_[i];
         // Nanson: n da = J F^-T N dA; the pressure pushes against the outward normal.
-        a[i] -= (p * F.determinant() * load.areas[k] / mass[i]) *
-                (F.inverse().transpose() * load.normals[k]);
+        a[i] -= (p * F.determinant() / mass[i]) * (F.inverse().transpose() * load.areas[k]);
       }
     if (!external_force_.empty())
       for (std::size_t i = 0; i < n; ++i) a[i] += external_force_[i] / mass[i];
