@@ -34,14 +34,15 @@ import matplotlib.pyplot as plt  # noqa: E402
 REPO_ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_COSPH = REPO_ROOT / "build" / "release" / "app" / "cosph"
 
-KINDS = ("profile", "time_series", "final")
+# period: the mean period of a time series' downward zero crossings (oscillating structures).
+KINDS = ("profile", "time_series", "final", "period")
 # Which quantity kinds each norm makes sense for: a spatial L2 needs a profile, an arrival time
 # needs a time series, a relative error at a point needs a single value.
 NORM_KINDS = {
-    "max": ("profile", "time_series", "final"),
+    "max": ("profile", "time_series", "final", "period"),
     "l2_relative": ("profile",),
     "l2_time": ("time_series",),
-    "relative_at_point": ("final",),
+    "relative_at_point": ("final", "period"),
     "arrival_time": ("time_series",),
 }
 NORM_TEXT = {
@@ -679,12 +680,29 @@ def extract_sample(quantity: Quantity, out_dir: Path) -> Sample:
     origin = next(iter(coordinates.values()), None)
     xyz = coordinates.get(label, (math.nan,) * 3)
     distance = math.dist(xyz, origin) if origin and label in coordinates else math.nan
+    if quantity.kind == "period":
+        return _period_sample(quantity, times, series, xyz, distance)
     if quantity.kind == "final":
         times, series = times[-1:], series[-1:]
     variables = {"x": np.full_like(times, xyz[0]), "y": np.full_like(times, xyz[1]),
                  "z": np.full_like(times, xyz[2]), "t": times,
                  "distance": np.full_like(times, distance)}
     return Sample(series, variables, times, "time", _field_of(quantity.column))
+
+
+def _period_sample(quantity: Quantity, times, series, xyz, distance) -> Sample:
+    """Mean period between the first and last downward zero crossings of the series."""
+    down = np.nonzero((series[:-1] > 0.0) & (series[1:] <= 0.0))[0]
+    if len(down) < 2:
+        raise ComparisonError(f"{quantity.column} crosses zero downwards {len(down)} time(s); "
+                              "a period needs two crossings (run longer)")
+    t0, t1, v0, v1 = times[down], times[down + 1], series[down], series[down + 1]
+    crossings = t0 + v0 * (t1 - t0) / (v0 - v1)
+    value = (crossings[-1] - crossings[0]) / (len(crossings) - 1)
+    t = times[-1:]
+    variables = {"x": np.full_like(t, xyz[0]), "y": np.full_like(t, xyz[1]),
+                 "z": np.full_like(t, xyz[2]), "t": t, "distance": np.full_like(t, distance)}
+    return Sample(np.array([value]), variables, t, "time", "period")
 
 
 def _combined_sample(quantity: Quantity, times, columns, values) -> Sample:
@@ -866,6 +884,8 @@ def quantity_text(quantity: Quantity) -> str:
     name = f"{quantity.label}: " if quantity.label else ""
     if quantity.kind == "time_series":
         return f"{name}time series of {quantity.column}"
+    if quantity.kind == "period":
+        return f"{name}mean period of the downward zero crossings of {quantity.column}"
     return f"{name}final value of {quantity.column}"
 
 
@@ -953,7 +973,7 @@ def _plot_best(ax, study: Study, results: list) -> None:
         ax.set_axis_off()
         return
     sample, reference = best.sample, best.reference_values
-    if study.quantity.kind == "final":
+    if study.quantity.kind in ("final", "period"):
         _plot_final_values(ax, study, results)
         return
     every = max(1, len(sample.values) // 40)
