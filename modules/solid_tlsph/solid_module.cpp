@@ -85,6 +85,7 @@ class SolidModule final : public StaticBodyModule<D> {
       if (o == "strain_energy") particles_.add_scalar("strain_energy", {.output = true});
       if (o == "fibre_strain") particles_.add_vector("fibre_strain", {.output = true});
       if (o == "stress") particles_.add_matrix("stress", {.output = true});
+      if (o == "hourglass") particles_.add_scalar("hourglass", {.output = true});
     }
     // T_a per particle: prescribed here, or added when a coupler first writes the port.
     if (spec_.has_active_tension())
@@ -159,6 +160,7 @@ class SolidModule final : public StaticBodyModule<D> {
   void prepare_output() override {
     const auto& u = particles_.vector("displacement");
     deformation_gradients<D>(pairs_, u, F_);
+    if (particles_.has("hourglass")) update_hourglass_measure();
     auto& J = particles_.scalar("J");
     const bool vm = particles_.has("von_mises"), energy = particles_.has("strain_energy"),
                fibre = particles_.has("fibre_strain"), stress = particles_.has("stress");
@@ -382,6 +384,25 @@ class SolidModule final : public StaticBodyModule<D> {
       }
       constraints_.push_back(std::move(constraint));
     }
+  }
+
+  // The non-affine part of each particle's neighbourhood motion, the amplitude of zero-energy
+  // (hourglass) modes: sqrt(sum_j W_ij |F_i X_ij - x_ij|^2 / sum_j W_ij |X_ij|^2).
+  void update_hourglass_measure() {
+    const auto& nl = pairs_.neighbours;
+    const auto& u = particles_.vector("displacement");
+    auto& measure = particles_.scalar("hourglass");
+    parallel_for_each_index(u.size(), [&](std::size_t i) {
+      double error = 0.0, scale = 0.0;
+      for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
+        const Index j = nl.index[k];
+        const Vec<D> X_ij = X_[j] - X_[i];
+        const double W = kernel_.value(X_ij.norm());
+        error += W * (F_[i] * X_ij - (X_ij + u[j] - u[i])).squaredNorm();
+        scale += W * X_ij.squaredNorm();
+      }
+      measure[i] = scale > 0.0 ? std::sqrt(error / scale) : 0.0;
+    });
   }
 
   // Surface particles of each pressure region, with their reference area vectors N dA.
