@@ -2,6 +2,7 @@
 
 #include "active_stress/active_stress_module.hpp"
 #include "diffusion/diffusion_module.hpp"
+#include "fluid_wcsph/fluid_module.hpp"
 #include "monodomain/monodomain_module.hpp"
 #include "solid_tlsph/solid_module.hpp"
 
@@ -14,6 +15,7 @@ const ModuleRegistry& builtin_modules() {
     r.add("monodomain", make_monodomain_module);
     r.add("active_stress", make_active_stress_module);
     r.add("solid", make_solid_module);
+    r.add("fluid", make_fluid_module);
     return r;
   }();
   return registry;

@@ -94,7 +94,8 @@ class StaticBodyModule : public Module {
   }
   void read_scalar_port(const std::string& port, const std::string& field, const FieldBuffer& in) {
     auto it = in.arrays.find(field);
-    if (it == in.arrays.end() || in.points != particles_.size() || it->second.components != 1)
+    if (it == in.arrays.end() || in.points != particles_.size() || it->second.components != 1 ||
+        it->second.values.size() != in.points)
       throw RuntimeError("module '" + name_ + "': port '" + port +
                          "' got a buffer of another shape");
     particles_.scalar(field) = it->second.values;

@@ -216,7 +216,8 @@ class SolidModule final : public StaticBodyModule<D> {
     if (port == "external_force") {
       auto it = in.arrays.find("force");
       const std::size_t n = particles_.size(), m = surface().particles.size();
-      if (it == in.arrays.end() || it->second.components != D || (in.points != n && in.points != m))
+      if (it == in.arrays.end() || it->second.components != D ||
+          (in.points != n && in.points != m) || it->second.values.size() != in.points * D)
         throw RuntimeError("module '" + name_ + "': port 'external_force' needs 'force' with " +
                            std::to_string(D) + " components per particle (" + std::to_string(n) +
                            ") or per interface particle (" + std::to_string(m) + ")");
@@ -237,7 +238,15 @@ class SolidModule final : public StaticBodyModule<D> {
           frames_ = build_fibre_frames<D>(spec_.fibres(), X_, spec_.body().spacing(),
                                           key_ + ".fibres", Base::scene_directory_);
       }
-      Base::read_scalar_port(port, "active_tension", in);
+      // The port carries the active_stress module's field `active_stress` (T_a per particle).
+      auto it = in.arrays.find("active_stress");
+      if (it == in.arrays.end() || in.points != particles_.size() || it->second.components != 1 ||
+          it->second.values.size() != in.points)
+        throw RuntimeError("module '" + name_ +
+                           "': port 'active_stress' needs 'active_stress' with one value per "
+                           "particle (" +
+                           std::to_string(particles_.size()) + ")");
+      particles_.scalar("active_tension") = it->second.values;
       return;
     }
     throw RuntimeError("module '" + name_ + "' has no port '" + port +

@@ -1,0 +1,570 @@
+#include "fluid_wcsph/fluid_module.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/parallel.hpp"
+#include "driver/scene_geometry.hpp"
+#include "expression/expression.hpp"
+#include "fluid_wcsph/riemann.hpp"
+#include "geometry/lattice.hpp"
+#include "neighbour/cell_linked_list.hpp"
+
+namespace cosph {
+namespace {
+
+// Per advection step: neighbour lists (fluid-fluid, fluid-wall), density treatment, viscous and
+// body forces, transport-velocity correction; then acoustic sub-steps of position-based Verlet
+// (seed 003 section 7) until the advection step is covered: the first half moves half a step and
+// updates the velocity with the Riemann pressure P*, the second half moves the other half and
+// updates the density with the Riemann velocity U*.
+template <int D>
+class FluidModule final : public Module {
+ public:
+  FluidModule(const proto::ModuleSpec& spec, const ModuleContext& context)
+      : name_(spec.name()),
+        key_(context.key_path + ".fluid"),
+        scene_(*context.scene),
+        scene_directory_(context.scene_directory),
+        spec_(spec.fluid()),
+        kernel_(build_kernel(spec_.body(), D)),
+        domain_(build_domain<D>(*context.scene)),
+        fluid_(spec_.body().name().empty() ? spec.name() : spec_.body().name()),
+        walls_(name_ + "_walls") {
+    if (spec_.has_sound_speed())
+      sound_speed_ = spec_.sound_speed();
+    else if (spec_.has_max_velocity())
+      sound_speed_ = 10.0 * spec_.max_velocity();
+    else
+      throw ConfigError(key_, "give max_velocity (the sound speed is 10 U_max) or sound_speed");
+    if (spec_.gravity_size() > 0) gravity_ = to_vec<D>(spec_.gravity());
+    for (int a = 0; a < spec_.initial_velocity_size(); ++a)
+      initial_velocity_.push_back(
+          parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));
+    initial_pressure_ = parse(spec_.initial_pressure(), key_ + ".initial_pressure");
+    for (int k = 0; k < spec_.walls_size(); ++k) {
+      std::vector<Expression> velocity;
+      for (int a = 0; a < spec_.walls(k).velocity_size(); ++a)
+        velocity.push_back(parse_time(
+            spec_.walls(k).velocity(a),
+            key_ + ".walls[" + std::to_string(k) + "].velocity[" + std::to_string(a) + "]"));
+      wall_velocity_.push_back(std::move(velocity));
+    }
+  }
+
+  ModuleInfo info() const override {
+    ModuleInfo info;
+    info.type = "fluid";
+    info.name = name_;
+    auto& f = info.active_features;
+    f.push_back("weakly-compressible SPH, kernel " + kernel_name(kernel_.type()));
+    f.push_back(spec_.riemann_solver() == "acoustic" ? "acoustic Riemann solver"
+                                                     : "low-dissipation Riemann solver");
+    f.push_back("density " + spec_.density_treatment());
+    f.push_back("dual-criteria time stepping");
+    if (spec_.viscosity() > 0.0) f.push_back("viscosity");
+    if (spec_.gravity_size() > 0) f.push_back("gravity");
+    if (spec_.transport_velocity()) f.push_back("transport velocity");
+    if (spec_.walls_size() > 0) f.push_back("walls (one-sided Riemann)");
+    if (domain_.any_periodic()) f.push_back("periodic");
+    for (const auto& o : spec_.outputs()) f.push_back("output " + o);
+    return info;
+  }
+
+  void initialize() override {
+    const ParticleCloud<D> cloud = build_body<D>(spec_.body(), key_ + ".body", scene_directory_);
+    check_inside_domain<D>(scene_, cloud, key_ + ".body");
+    const std::size_t n = cloud.positions.size();
+    fluid_.resize(n);
+    auto& x = fluid_.add_vector("position", {.output = true, .checkpoint = true});
+    auto& v = fluid_.add_vector("velocity", {.output = true, .checkpoint = true});
+    auto& rho = fluid_.add_scalar("density", {.output = true, .checkpoint = true});
+    auto& p = fluid_.add_scalar("pressure", {.output = true});
+    auto& m = fluid_.add_scalar("mass", {.checkpoint = true});
+    auto& volume = fluid_.add_scalar("volume");
+    fluid_.add_scalar("density_rate", {.checkpoint = true});
+    fluid_.add_vector("acceleration");
+    if (has_output("vorticity")) fluid_.add_scalar("vorticity", {.output = true});
+    const double rho0 = spec_.density(), c2 = sound_speed_ * sound_speed_;
+    for (std::size_t i = 0; i < n; ++i) {
+      x[i] = domain_.any_periodic() ? domain_.wrap(cloud.positions[i]) : cloud.positions[i];
+      const auto point = space(x[i]);
+      p[i] = initial_pressure_.evaluate(point);
+      rho[i] = rho0 + p[i] / c2;
+      m[i] = rho0 * cloud.volumes[i];
+      volume[i] = m[i] / rho[i];
+      for (int a = 0; a < D && !initial_velocity_.empty(); ++a)
+        v[i][a] = initial_velocity_[a].evaluate(point);
+    }
+    sort_by_cell();
+    build_walls();
+    reference_number_density_ = lattice_number_density();
+    build_neighbours();
+  }
+
+  double max_dt() const override {
+    const double h = kernel_.smoothing_length();
+    const double speed = std::max(max_speed(), 0.1 * sound_speed_);
+    double dt = h / speed;
+    if (spec_.viscosity() > 0.0) dt = std::min(dt, h * h * spec_.density() / spec_.viscosity());
+    return spec_.advection_cfl() * dt;
+  }
+
+  void advance(double Dt) override {
+    if (steps_ > 0 && steps_ % kSortInterval == 0) sort_by_cell();
+    build_neighbours();
+    if (spec_.density_treatment() != "none") update_density_by_summation();
+    update_prior_acceleration();
+    if (spec_.transport_velocity()) correct_transport_velocity();
+    const double h = kernel_.smoothing_length();
+    double done = 0.0;
+    while (done < Dt * (1.0 - 1e-12)) {
+      const double dt =
+          std::min(spec_.acoustic_cfl() * h / (sound_speed_ + max_speed()), Dt - done);
+      pressure_relaxation(dt);
+      density_relaxation(dt);
+      done += dt;
+      ++acoustic_steps_;
+    }
+    update_volumes();
+    time_ += Dt;
+    ++steps_;
+  }
+
+  double time() const override { return time_; }
+
+  void prepare_output() override {
+    if (!fluid_.has("vorticity")) return;
+    if constexpr (D == 2) {
+      const auto& x = fluid_.vector("position");
+      const auto& v = fluid_.vector("velocity");
+      const auto& volume = fluid_.scalar("volume");
+      auto& w = fluid_.scalar("vorticity");
+      const CellLinkedList<D> cells(x, kernel_.support_radius(), domain_);
+      parallel_for_each_index(x.size(), [&](std::size_t i) {
+        double sum = 0.0;
+        cells.for_each_neighbour(x[i], kernel_.support_radius(), Index(i), [&](Index j) {
+          const Vec<D> d = domain_.displacement(x[i], x[j]);
+          const double r = d.norm();
+          const Vec<D> grad = kernel_.derivative(r) / r * d;  // grad_i W_ij
+          const Vec<D> dv = v[j] - v[i];
+          sum += volume[j] * (dv[1] * grad[0] - dv[0] * grad[1]);
+        });
+        w[i] = -sum;  // omega = dv_y/dx - dv_x/dy
+      });
+    }
+  }
+
+  void write(const std::string& port, FieldBuffer&) const override {
+    throw RuntimeError("module '" + name_ + "' has no port '" + port + "' yet");
+  }
+  void read(const std::string& port, const FieldBuffer&) override {
+    throw RuntimeError("module '" + name_ + "' has no port '" + port + "' yet");
+  }
+
+  void save(StateRecord& state) const override {
+    for (const char* f : {"position", "velocity", "density", "density_rate", "mass"}) {
+      const auto raw = fluid_.raw(f);
+      state.arrays[f].assign(raw.begin(), raw.end());
+    }
+    state.scalars["time"] = time_;
+    state.integers["steps"] = steps_;
+    state.integers["acoustic_steps"] = acoustic_steps_;
+  }
+
+  void load(const StateRecord& state) override {
+    for (const char* f : {"position", "velocity", "density", "density_rate", "mass"}) {
+      auto it = state.arrays.find(f);
+      auto raw = fluid_.raw(f);
+      if (it == state.arrays.end() || it->second.size() != raw.size())
+        throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
+                           std::to_string(raw.size()) + " values of '" + f + "'");
+      std::copy(it->second.begin(), it->second.end(), raw.begin());
+    }
+    time_ = state.scalars.at("time");
+    steps_ = state.integers.at("steps");
+    acoustic_steps_ = state.integers.at("acoustic_steps");
+    update_pressure();
+    update_volumes();
+  }
+
+  void bodies(BodyViews& views) const override {
+    BodyView<D> fluid{name_, &fluid_, kernel_, domain_};
+    BodyView<D> walls{name_, &walls_, kernel_, domain_};
+    if constexpr (D == 2) {
+      views.bodies2.push_back(fluid);
+      if (walls_.size() > 0) views.bodies2.push_back(walls);
+    } else {
+      views.bodies3.push_back(fluid);
+      if (walls_.size() > 0) views.bodies3.push_back(walls);
+    }
+  }
+  std::size_t particle_count() const override { return fluid_.size() + walls_.size(); }
+
+  // Weak compressibility: the density stays within 30% of rho0 (a healthy run stays within a
+  // few percent; beyond this the sound speed is too low for the flow).
+  std::optional<HealthProblem> check_health() const override {
+    const auto& rho = fluid_.scalar("density");
+    const double rho0 = spec_.density();
+    for (std::size_t i = 0; i < rho.size(); ++i)
+      if (!(rho[i] > 0.7 * rho0 && rho[i] < 1.3 * rho0))
+        return HealthProblem{"density", static_cast<long long>(i), rho[i],
+                             "within 30% of rho0 (weakly compressible)"};
+    return std::nullopt;
+  }
+
+ private:
+  static constexpr long long kSortInterval = 100;
+
+  static Expression parse(const std::string& text, const std::string& key) {
+    try {
+      return Expression::parse(text, {"x", "y", "z"});
+    } catch (const ExpressionError& e) {
+      throw ConfigError(key, e.what());
+    }
+  }
+  static Expression parse_time(const std::string& text, const std::string& key) {
+    try {
+      return Expression::parse(text, {"t"});
+    } catch (const ExpressionError& e) {
+      throw ConfigError(key, e.what());
+    }
+  }
+  static std::array<double, 3> space(const Vec<D>& x) {
+    std::array<double, 3> p{0.0, 0.0, 0.0};
+    for (int a = 0; a < D; ++a) p[a] = x[a];
+    return p;
+  }
+  bool has_output(const std::string& name) const {
+    return std::find(spec_.outputs().begin(), spec_.outputs().end(), name) != spec_.outputs().end();
+  }
+
+  double max_speed() const {
+    const auto& v = fluid_.vector("velocity");
+    double s = 0.0;
+    for (const auto& u : v) s = std::max(s, u.squaredNorm());
+    return std::sqrt(s);
+  }
+
+  RiemannSolver riemann() const {
+    return {spec_.density() * sound_speed_, sound_speed_,
+            spec_.riemann_solver() == "low_dissipation"};
+  }
+
+  void sort_by_cell() {
+    const auto order =
+        cell_sort_order<D>(fluid_.vector("position"), kernel_.support_radius(), domain_);
+    fluid_.permute(order);
+  }
+
+  void build_walls() {
+    const double dp = spec_.body().spacing();
+    std::vector<Vec<D>> x;
+    std::vector<double> volume;
+    std::vector<int> owner;
+    for (int k = 0; k < spec_.walls_size(); ++k) {
+      const auto& w = spec_.walls(k);
+      const std::string path = key_ + ".walls[" + std::to_string(k) + "]";
+      auto shape = build_shape<D>(w.shape(), path + ".shape");
+      Vec<D> anchor = w.lattice_anchor_size() > 0 ? to_vec<D>(w.lattice_anchor())
+                      : spec_.body().lattice_anchor_size() > 0
+                          ? to_vec<D>(spec_.body().lattice_anchor())
+                          : Vec<D>(Vec<D>::Zero());
+      ParticleCloud<D> cloud;
+      try {
+        cloud = lattice_fill<D>(*shape, dp, anchor);
+      } catch (const std::invalid_argument& e) {
+        throw ConfigError(path + ".shape", e.what());
+      }
+      check_inside_domain<D>(scene_, cloud, path + ".shape");
+      for (std::size_t i = 0; i < cloud.positions.size(); ++i) {
+        x.push_back(cloud.positions[i]);
+        volume.push_back(cloud.volumes[i]);
+        owner.push_back(k);
+      }
+    }
+    walls_.resize(x.size());
+    walls_.add_vector("position", {.output = true}) = x;
+    walls_.add_scalar("volume", {.output = true}) = volume;
+    walls_.add_vector("velocity", {.output = true});
+    wall_owner_ = owner;
+    update_wall_velocity(0.0);
+  }
+
+  void update_wall_velocity(double t) {
+    if (walls_.size() == 0) return;
+    auto& v = walls_.vector("velocity");
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const auto& expressions = wall_velocity_[wall_owner_[i]];
+      for (int a = 0; a < D; ++a)
+        v[i][a] = expressions.empty() ? 0.0 : expressions[a].evaluate({t});
+    }
+  }
+
+  // Moving walls move with their prescribed velocity (whole advection step, explicit).
+  void move_walls(double dt) {
+    if (walls_.size() == 0) return;
+    bool moving = false;
+    for (const auto& w : wall_velocity_) moving = moving || !w.empty();
+    if (!moving) return;
+    update_wall_velocity(time_ + 0.5 * dt);
+    auto& x = walls_.vector("position");
+    const auto& v = walls_.vector("velocity");
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] += dt * v[i];
+  }
+
+  // sum_k dp^D W(|k| dp) over a full lattice: the number density of a particle with a complete
+  // neighbourhood, the reference of the density summation.
+  double lattice_number_density() const {
+    const double dp = spec_.body().spacing(), support = kernel_.support_radius();
+    const int reach = static_cast<int>(std::ceil(support / dp)) + 1;
+    double sum = 0.0;
+    std::array<int, D> k;
+    k.fill(-reach);
+    while (true) {
+      Vec<D> r;
+      for (int a = 0; a < D; ++a) r[a] = k[a] * dp;
+      sum += std::pow(dp, D) * kernel_.value(r.norm());
+      int a = 0;
+      for (; a < D; ++a) {
+        if (++k[a] <= reach) break;
+        k[a] = -reach;
+      }
+      if (a == D) break;
+    }
+    return sum;
+  }
+
+  void build_neighbours() {
+    const auto& x = fluid_.vector("position");
+    inner_ = build_inner_list<D>(x, kernel_.support_radius(), domain_);
+    if (walls_.size() > 0)
+      contact_ =
+          build_contact_list<D>(x, walls_.vector("position"), kernel_.support_radius(), domain_);
+  }
+
+  // Eq. 12 (free surface: never below the continuity density) or eq. 13 (confined).
+  void update_density_by_summation() {
+    const auto& x = fluid_.vector("position");
+    const auto& m = fluid_.scalar("mass");
+    auto& rho = fluid_.scalar("density");
+    const double rho0 = spec_.density(), sigma0 = reference_number_density_;
+    const bool free_surface = spec_.density_treatment() == "reinitialisation";
+    const std::vector<Vec<D>>* wx = walls_.size() > 0 ? &walls_.vector("position") : nullptr;
+    const std::vector<double>* wv = walls_.size() > 0 ? &walls_.scalar("volume") : nullptr;
+    parallel_for_each_index(x.size(), [&](std::size_t i) {
+      double sigma = m[i] / rho0 * kernel_.value(0.0);
+      for (Index j : inner_.of(i))
+        sigma += m[j] / rho0 * kernel_.value(domain_.displacement(x[i], x[j]).norm());
+      if (wx)
+        for (Index w : contact_.of(i))
+          sigma += (*wv)[w] * kernel_.value(domain_.displacement(x[i], (*wx)[w]).norm());
+      const double summed = rho0 * sigma / sigma0;
+      rho[i] = free_surface ? std::max(rho[i], summed) : summed;
+    });
+    update_pressure();
+  }
+
+  void update_pressure() {
+    const auto& rho = fluid_.scalar("density");
+    auto& p = fluid_.scalar("pressure");
+    const double c2 = sound_speed_ * sound_speed_, rho0 = spec_.density();
+    for (std::size_t i = 0; i < rho.size(); ++i) p[i] = c2 * (rho[i] - rho0);
+  }
+
+  void update_volumes() {
+    const auto& rho = fluid_.scalar("density");
+    const auto& m = fluid_.scalar("mass");
+    auto& volume = fluid_.scalar("volume");
+    for (std::size_t i = 0; i < rho.size(); ++i) volume[i] = m[i] / rho[i];
+  }
+
+  // Gravity and viscosity (seed 003 eq. 10), once per advection step; walls are no-slip through
+  // the mirrored velocity 2 v_wall - v_i.
+  void update_prior_acceleration() {
+    const auto& x = fluid_.vector("position");
+    const auto& v = fluid_.vector("velocity");
+    const auto& rho = fluid_.scalar("density");
+    const auto& m = fluid_.scalar("mass");
+    auto& a = fluid_.vector("acceleration");
+    const double eta = spec_.viscosity();
+    const bool walls = walls_.size() > 0;
+    parallel_for_each_index(x.size(), [&](std::size_t i) {
+      Vec<D> sum = Vec<D>::Zero();
+      if (eta > 0.0) {
+        for (Index j : inner_.of(i)) {
+          const double r = domain_.displacement(x[i], x[j]).norm();
+          if (r <= 0.0) continue;
+          sum += (m[j] / rho[j] * kernel_.derivative(r) / r) * (v[i] - v[j]);
+        }
+        if (walls) {
+          const auto& wx = walls_.vector("position");
+          const auto& wv = walls_.vector("velocity");
+          const auto& wV = walls_.scalar("volume");
+          for (Index w : contact_.of(i)) {
+            const double r = domain_.displacement(x[i], wx[w]).norm();
+            if (r <= 0.0) continue;
+            sum += (wV[w] * kernel_.derivative(r) / r) * (2.0 * (v[i] - wv[w]));
+          }
+        }
+        sum *= 2.0 * eta / rho[i];
+      }
+      a[i] = sum + gravity_;
+    });
+  }
+
+  // Shifts particles away from crowded neighbourhoods (confined flows): a background-pressure
+  // transport velocity (seed 003 eq. 11) applied as a position correction 0.2 h^2 per step.
+  void correct_transport_velocity() {
+    auto& x = fluid_.vector("position");
+    const auto& volume = fluid_.scalar("volume");
+    const double h = kernel_.smoothing_length();
+    std::vector<Vec<D>> shift(x.size(), Vec<D>::Zero());
+    const bool walls = walls_.size() > 0;
+    parallel_for_each_index(x.size(), [&](std::size_t i) {
+      Vec<D> sum = Vec<D>::Zero();
+      for (Index j : inner_.of(i)) {
+        const Vec<D> d = domain_.displacement(x[i], x[j]);
+        const double r = d.norm();
+        if (r > 0.0) sum += volume[j] * kernel_.derivative(r) / r * d;
+      }
+      if (walls) {
+        const auto& wx = walls_.vector("position");
+        const auto& wV = walls_.scalar("volume");
+        for (Index w : contact_.of(i)) {
+          const Vec<D> d = domain_.displacement(x[i], wx[w]);
+          const double r = d.norm();
+          if (r > 0.0) sum += wV[w] * kernel_.derivative(r) / r * d;
+        }
+      }
+      shift[i] = -0.2 * h * h * sum;
+    });
+    parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift[i]); });
+  }
+
+  Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
+
+  // First half: density and position to mid-step, velocity over the step from P*.
+  void pressure_relaxation(double dt) {
+    auto& x = fluid_.vector("position");
+    auto& v = fluid_.vector("velocity");
+    auto& rho = fluid_.scalar("density");
+    auto& p = fluid_.scalar("pressure");
+    const auto& drho = fluid_.scalar("density_rate");
+    const auto& m = fluid_.scalar("mass");
+    const auto& prior = fluid_.vector("acceleration");
+    const double c2 = sound_speed_ * sound_speed_, rho0 = spec_.density();
+    parallel_for_each_index(x.size(), [&](std::size_t i) {
+      rho[i] += 0.5 * dt * drho[i];
+      p[i] = c2 * (rho[i] - rho0);
+      x[i] = wrap(x[i] + 0.5 * dt * v[i]);
+    });
+    const RiemannSolver solver = riemann();
+    const bool walls = walls_.size() > 0;
+    dv_.resize(x.size());
+    parallel_for_each_index(x.size(), [&](std::size_t i) {
+      Vec<D> sum = Vec<D>::Zero();
+      for (Index j : inner_.of(i)) {
+        const Vec<D> d = domain_.displacement(x[j], x[i]);
+        const double r = d.norm();
+        if (!(r > 0.0) || r >= kernel_.support_radius()) continue;
+        const Vec<D> e = d / r;
+        const double P = solver.pressure(p[i], p[j], v[i].dot(e), v[j].dot(e));
+        sum -= (m[j] / rho[j] * P * -kernel_.derivative(r)) * e;
+      }
+      if (walls) {
+        const auto& wx = walls_.vector("position");
+        const auto& wv = walls_.vector("velocity");
+        const auto& wV = walls_.scalar("volume");
+        for (Index w : contact_.of(i)) {
+          const Vec<D> d = domain_.displacement(wx[w], x[i]);
+          const double r = d.norm();
+          if (!(r > 0.0) || r >= kernel_.support_radius()) continue;
+          const Vec<D> e = d / r;
+          // One-sided Riemann problem (seed 003 eqs. 14-16): the wall mirrors the particle's
+          // velocity about its own and extends its pressure hydrostatically.
+          const Vec<D> mirrored = 2.0 * wv[w] - v[i];
+          const double p_wall = p[i] + rho[i] * gravity_.dot(d);
+          const double P = solver.pressure(p[i], p_wall, v[i].dot(e), mirrored.dot(e));
+          sum -= (wV[w] * P * -kernel_.derivative(r)) * e;
+        }
+      }
+      dv_[i] = (2.0 / rho[i]) * sum;
+    });
+    parallel_for_each_index(x.size(), [&](std::size_t i) { v[i] += dt * (dv_[i] + prior[i]); });
+  }
+
+  // Second half: position to the end of the step, density rate from U*, density half step.
+  void density_relaxation(double dt) {
+    auto& x = fluid_.vector("position");
+    const auto& v = fluid_.vector("velocity");
+    auto& rho = fluid_.scalar("density");
+    const auto& p = fluid_.scalar("pressure");
+    auto& drho = fluid_.scalar("density_rate");
+    const auto& m = fluid_.scalar("mass");
+    parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + 0.5 * dt * v[i]); });
+    move_walls(dt);
+    const RiemannSolver solver = riemann();
+    const bool walls = walls_.size() > 0;
+    parallel_for_each_index(x.size(), [&](std::size_t i) {
+      double sum = 0.0;
+      for (Index j : inner_.of(i)) {
+        const Vec<D> d = domain_.displacement(x[j], x[i]);
+        const double r = d.norm();
+        if (!(r > 0.0) || r >= kernel_.support_radius()) continue;
+        const Vec<D> e = d / r;
+        const double u = v[i].dot(e);
+        const double U = solver.velocity(p[i], p[j], u, v[j].dot(e));
+        sum += m[j] / rho[j] * (u - U) * -kernel_.derivative(r);
+      }
+      if (walls) {
+        const auto& wx = walls_.vector("position");
+        const auto& wv = walls_.vector("velocity");
+        const auto& wV = walls_.scalar("volume");
+        for (Index w : contact_.of(i)) {
+          const Vec<D> d = domain_.displacement(wx[w], x[i]);
+          const double r = d.norm();
+          if (!(r > 0.0) || r >= kernel_.support_radius()) continue;
+          const Vec<D> e = d / r;
+          const Vec<D> mirrored = 2.0 * wv[w] - v[i];
+          const double p_wall = p[i] + rho[i] * gravity_.dot(d);
+          const double u = v[i].dot(e);
+          const double U = solver.velocity(p[i], p_wall, u, mirrored.dot(e));
+          sum += wV[w] * (u - U) * -kernel_.derivative(r);
+        }
+      }
+      drho[i] = 2.0 * rho[i] * sum;
+    });
+    parallel_for_each_index(x.size(), [&](std::size_t i) { rho[i] += 0.5 * dt * drho[i]; });
+  }
+
+  std::string name_, key_;
+  const proto::Scene& scene_;
+  std::string scene_directory_;
+  proto::FluidSpec spec_;
+  Kernel kernel_;
+  Domain<D> domain_;
+  ParticleSet<D> fluid_, walls_;
+  std::vector<int> wall_owner_;
+  std::vector<std::vector<Expression>> wall_velocity_;
+  std::vector<Expression> initial_velocity_;
+  Expression initial_pressure_;
+  Vec<D> gravity_ = Vec<D>::Zero();
+  double sound_speed_ = 0.0, reference_number_density_ = 1.0;
+  NeighbourList inner_, contact_;
+  std::vector<Vec<D>> dv_;
+  double time_ = 0.0;
+  long long steps_ = 0, acoustic_steps_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Module> make_fluid_module(const proto::ModuleSpec& spec,
+                                          const ModuleContext& context) {
+  if (context.scene->dimension() == 2) return std::make_unique<FluidModule<2>>(spec, context);
+  return std::make_unique<FluidModule<3>>(spec, context);
+}
+
+}  // namespace cosph

@@ -1,0 +1,29 @@
+// The inter-particle Riemann problem of weakly-compressible SPH (seed 003 section 2.2; Zhang, Hu
+// & Adams 2017). Along the unit vector e from particle i (left) to j (right), the linearised
+// (acoustic) solution for equal impedances Z = rho0 c is
+//   P* = (p_L + p_R)/2 + beta Z (u_L - u_R)/2,     U* = (u_L + u_R)/2 + (p_L - p_R)/(2 Z),
+// with u = v . e. beta = 1 is the plain acoustic solver; the low-dissipation limiter
+// beta = min(3 max(u_L - u_R, 0) / c, 1) keeps the dissipation only where particles approach
+// fast (impacts) and removes it from smooth flow. The limiter acts on the momentum equation only.
+#pragma once
+
+#include <algorithm>
+
+namespace cosph {
+
+struct RiemannSolver {
+  double impedance;    // Z = rho0 c
+  double sound_speed;  // c
+  bool limited;        // low-dissipation limiter
+
+  double pressure(double p_left, double p_right, double u_left, double u_right) const {
+    const double jump = u_left - u_right;
+    const double beta = limited ? std::min(3.0 * std::max(jump, 0.0) / sound_speed, 1.0) : 1.0;
+    return 0.5 * (p_left + p_right) + 0.5 * beta * impedance * jump;
+  }
+  double velocity(double p_left, double p_right, double u_left, double u_right) const {
+    return 0.5 * (u_left + u_right) + 0.5 * (p_left - p_right) / impedance;
+  }
+};
+
+}  // namespace cosph
