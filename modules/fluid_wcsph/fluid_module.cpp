@@ -337,12 +337,38 @@ class FluidModule final : public Module {
     return sum;
   }
 
+  // Neighbour lists and, per pair, the unit vector e_ij (from i to j) and -dW/dr at the
+  // configuration of the advection step. The acoustic sub-steps reuse them (as SPHinXsys does):
+  // particles move less than a quarter smoothing length per advection step.
   void build_neighbours() {
     const auto& x = fluid_.vector("position");
     inner_ = build_inner_list<D>(x, kernel_.support_radius(), domain_);
-    if (walls_.size() > 0)
-      contact_ =
-          build_contact_list<D>(x, walls_.vector("position"), kernel_.support_radius(), domain_);
+    pair_geometry(x, x, inner_, inner_geometry_);
+    if (walls_.size() > 0) {
+      const auto& wx = walls_.vector("position");
+      contact_ = build_contact_list<D>(x, wx, kernel_.support_radius(), domain_);
+      pair_geometry(x, wx, contact_, contact_geometry_);
+    }
+  }
+
+  struct PairGeometry {
+    std::vector<Vec<D>> direction;  // e_ij = (x_j - x_i) / r_ij
+    std::vector<double> gradient;   // -dW/dr (r_ij) >= 0
+  };
+
+  void pair_geometry(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,
+                     const NeighbourList& list, PairGeometry& g) const {
+    g.direction.resize(list.pair_count());
+    g.gradient.resize(list.pair_count());
+    parallel_for_each_index(a.size(), [&](std::size_t i) {
+      for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k) {
+        const Vec<D> d = domain_.displacement(b[list.index[k]], a[i]);
+        const double r = d.norm();
+        const bool ok = r > 0.0;
+        g.direction[k] = ok ? Vec<D>(d / r) : Vec<D>(Vec<D>::Zero());
+        g.gradient[k] = ok ? -kernel_.derivative(r) : 0.0;
+      }
+    });
   }
 
   // Eq. 12 (free surface: never below the continuity density) or eq. 13 (confined).
@@ -391,6 +417,9 @@ class FluidModule final : public Module {
     auto& a = fluid_.vector("acceleration");
     const double eta = spec_.viscosity();
     const bool walls = walls_.size() > 0;
+    const auto& wx = walls_.vector("position");
+    const auto& wv = walls_.vector("velocity");
+    const auto& wV = walls_.scalar("volume");
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
       if (eta > 0.0) {
@@ -400,9 +429,6 @@ class FluidModule final : public Module {
           sum += (m[j] / rho[j] * kernel_.derivative(r) / r) * (v[i] - v[j]);
         }
         if (walls) {
-          const auto& wx = walls_.vector("position");
-          const auto& wv = walls_.vector("velocity");
-          const auto& wV = walls_.scalar("volume");
           for (Index w : contact_.of(i)) {
             const double r = domain_.displacement(x[i], wx[w]).norm();
             if (r <= 0.0) continue;
@@ -423,6 +449,8 @@ class FluidModule final : public Module {
     const double h = kernel_.smoothing_length();
     std::vector<Vec<D>> shift(x.size(), Vec<D>::Zero());
     const bool walls = walls_.size() > 0;
+    const auto& wx = walls_.vector("position");
+    const auto& wV = walls_.scalar("volume");
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
       for (Index j : inner_.of(i)) {
@@ -431,8 +459,6 @@ class FluidModule final : public Module {
         if (r > 0.0) sum += volume[j] * kernel_.derivative(r) / r * d;
       }
       if (walls) {
-        const auto& wx = walls_.vector("position");
-        const auto& wV = walls_.scalar("volume");
         for (Index w : contact_.of(i)) {
           const Vec<D> d = domain_.displacement(x[i], wx[w]);
           const double r = d.norm();
@@ -456,39 +482,37 @@ class FluidModule final : public Module {
     const auto& m = fluid_.scalar("mass");
     const auto& prior = fluid_.vector("acceleration");
     const double c2 = sound_speed_ * sound_speed_, rho0 = spec_.density();
+    auto& volume = fluid_.scalar("volume");
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       rho[i] += 0.5 * dt * drho[i];
       p[i] = c2 * (rho[i] - rho0);
+      volume[i] = m[i] / rho[i];
       x[i] = wrap(x[i] + 0.5 * dt * v[i]);
     });
     const RiemannSolver solver = riemann();
     const bool walls = walls_.size() > 0;
+    const auto& wx = walls_.vector("position");
+    const auto& wv = walls_.vector("velocity");
+    const auto& wV = walls_.scalar("volume");
     dv_.resize(x.size());
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
-      for (Index j : inner_.of(i)) {
-        const Vec<D> d = domain_.displacement(x[j], x[i]);
-        const double r = d.norm();
-        if (!(r > 0.0) || r >= kernel_.support_radius()) continue;
-        const Vec<D> e = d / r;
+      for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
+        const Index j = inner_.index[k];
+        const Vec<D>& e = inner_geometry_.direction[k];
         const double P = solver.pressure(p[i], p[j], v[i].dot(e), v[j].dot(e));
-        sum -= (m[j] / rho[j] * P * -kernel_.derivative(r)) * e;
+        sum -= (volume[j] * P * inner_geometry_.gradient[k]) * e;
       }
       if (walls) {
-        const auto& wx = walls_.vector("position");
-        const auto& wv = walls_.vector("velocity");
-        const auto& wV = walls_.scalar("volume");
-        for (Index w : contact_.of(i)) {
-          const Vec<D> d = domain_.displacement(wx[w], x[i]);
-          const double r = d.norm();
-          if (!(r > 0.0) || r >= kernel_.support_radius()) continue;
-          const Vec<D> e = d / r;
+        for (std::size_t k = contact_.offset[i]; k < contact_.offset[i + 1]; ++k) {
+          const Index w = contact_.index[k];
+          const Vec<D>& e = contact_geometry_.direction[k];
           // One-sided Riemann problem (seed 003 eqs. 14-16): the wall mirrors the particle's
           // velocity about its own and extends its pressure hydrostatically.
           const Vec<D> mirrored = 2.0 * wv[w] - v[i];
-          const double p_wall = p[i] + rho[i] * gravity_.dot(d);
+          const double p_wall = p[i] + rho[i] * gravity_.dot(domain_.displacement(wx[w], x[i]));
           const double P = solver.pressure(p[i], p_wall, v[i].dot(e), mirrored.dot(e));
-          sum -= (wV[w] * P * -kernel_.derivative(r)) * e;
+          sum -= (wV[w] * P * contact_geometry_.gradient[k]) * e;
         }
       }
       dv_[i] = (2.0 / rho[i]) * sum;
@@ -503,36 +527,32 @@ class FluidModule final : public Module {
     auto& rho = fluid_.scalar("density");
     const auto& p = fluid_.scalar("pressure");
     auto& drho = fluid_.scalar("density_rate");
-    const auto& m = fluid_.scalar("mass");
+    const auto& volume = fluid_.scalar("volume");  // m / rho of the first half
     parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + 0.5 * dt * v[i]); });
     move_walls(dt);
     const RiemannSolver solver = riemann();
     const bool walls = walls_.size() > 0;
+    const auto& wx = walls_.vector("position");
+    const auto& wv = walls_.vector("velocity");
+    const auto& wV = walls_.scalar("volume");
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       double sum = 0.0;
-      for (Index j : inner_.of(i)) {
-        const Vec<D> d = domain_.displacement(x[j], x[i]);
-        const double r = d.norm();
-        if (!(r > 0.0) || r >= kernel_.support_radius()) continue;
-        const Vec<D> e = d / r;
+      for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
+        const Index j = inner_.index[k];
+        const Vec<D>& e = inner_geometry_.direction[k];
         const double u = v[i].dot(e);
         const double U = solver.velocity(p[i], p[j], u, v[j].dot(e));
-        sum += m[j] / rho[j] * (u - U) * -kernel_.derivative(r);
+        sum += volume[j] * (u - U) * inner_geometry_.gradient[k];
       }
       if (walls) {
-        const auto& wx = walls_.vector("position");
-        const auto& wv = walls_.vector("velocity");
-        const auto& wV = walls_.scalar("volume");
-        for (Index w : contact_.of(i)) {
-          const Vec<D> d = domain_.displacement(wx[w], x[i]);
-          const double r = d.norm();
-          if (!(r > 0.0) || r >= kernel_.support_radius()) continue;
-          const Vec<D> e = d / r;
+        for (std::size_t k = contact_.offset[i]; k < contact_.offset[i + 1]; ++k) {
+          const Index w = contact_.index[k];
+          const Vec<D>& e = contact_geometry_.direction[k];
           const Vec<D> mirrored = 2.0 * wv[w] - v[i];
-          const double p_wall = p[i] + rho[i] * gravity_.dot(d);
+          const double p_wall = p[i] + rho[i] * gravity_.dot(domain_.displacement(wx[w], x[i]));
           const double u = v[i].dot(e);
           const double U = solver.velocity(p[i], p_wall, u, mirrored.dot(e));
-          sum += wV[w] * (u - U) * -kernel_.derivative(r);
+          sum += wV[w] * (u - U) * contact_geometry_.gradient[k];
         }
       }
       drho[i] = 2.0 * rho[i] * sum;
@@ -554,6 +574,7 @@ class FluidModule final : public Module {
   Vec<D> gravity_ = Vec<D>::Zero();
   double sound_speed_ = 0.0, reference_number_density_ = 1.0;
   NeighbourList inner_, contact_;
+  PairGeometry inner_geometry_, contact_geometry_;
   std::vector<Vec<D>> dv_;
   double time_ = 0.0;
   long long steps_ = 0, acoustic_steps_ = 0;
