@@ -465,7 +465,7 @@ class FluidModule final : public Module {
           if (r > 0.0) sum += wV[w] * kernel_.derivative(r) / r * d;
         }
       }
-      shift[i] = -0.2 * h * h * sum;
+      shift[i] = -0.4 * h * h * sum;
     });
     parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift[i]); });
   }

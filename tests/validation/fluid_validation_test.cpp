@@ -1,6 +1,7 @@
 // The fluid against Lobovsky et al.'s (2014) dam-break experiment (bench/reference/
 // lobovsky2014_sensor1.csv): the impact time at pressure sensor 1 and the pressure plateau after
-// the impact, at dp = H/40 (the study in docs/VALIDATION.md goes to H/80).
+// the impact, at dp = H/40 (bench/studies/fluid_dambreak_impact.yaml goes to H/80); and the
+// transient Poiseuille flow against its series solution.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -81,6 +82,50 @@ TEST(FluidValidation, DamBreakImpactAndPlateauAtSensorOneMatchTheExperiment) {
             << "), plateau p/(rho g H) " << plateau << " (experiment " << expected << ")\n";
   EXPECT_NEAR(impact, measured, 0.35);              // measured 0.25 late at H/40, 0.11 at H/80
   EXPECT_NEAR(plateau, expected, 0.25 * expected);  // the hydrostatic-like load after the impact
+}
+
+// Transient Poiseuille flow between no-slip plates (examples/fluid_poiseuille.yaml): the series
+// solution with g = 0.8, nu = 0.1, L = 1.
+double poiseuille(double y, double t) {
+  const double g = 0.8, nu = 0.1, pi = 3.14159265358979323846;
+  double u = g * y * (1.0 - y) / (2.0 * nu);
+  for (int n = 0; n < 100; ++n) {
+    const double m = 2 * n + 1;
+    u -= 4.0 * g / (nu * pi * pi * pi * m * m * m) * std::sin(m * pi * y) *
+         std::exp(-m * m * pi * pi * nu * t);
+  }
+  return u;
+}
+
+TEST(FluidValidation, PoiseuilleFlowFollowsTheAnalyticTransient) {
+  RunOptions options;
+  options.progress = false;
+  options.output_directory = testing::TempDir() + "cosph_fluid_poiseuille";
+  const std::string scene = std::string(COSPH_SOURCE_DIR) + "/examples/fluid_poiseuille.yaml";
+  Simulation simulation(load_scene_file(scene, {"output.interval=2"}), builtin_modules(), options);
+  simulation.initialize();
+  simulation.run();
+  const Series centre = read_probe(options.output_directory + "/centre.csv", 1);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < centre.t.size(); ++k) {
+    if (centre.t[k] < 0.2) continue;  // relative errors of the first, tiny velocities
+    const double expected = poiseuille(0.5, centre.t[k]);
+    worst = std::max(worst, std::abs(centre.value[k] - expected) / expected);
+  }
+  // The profile across the channel at the end (20 points from y = 0.025 to 0.975).
+  double diff = 0.0, norm = 0.0;
+  for (int k = 1; k <= 20; ++k) {
+    const Series profile = read_probe(options.output_directory + "/profile.csv", k);
+    const double y = 0.025 + 0.95 * (k - 1) / 19.0;
+    const double expected = poiseuille(y, profile.t.back());
+    diff += (profile.value.back() - expected) * (profile.value.back() - expected);
+    norm += expected * expected;
+  }
+  std::cout << "Poiseuille: centre-line velocity within " << worst
+            << " of the analytic transient; final profile relative L2 " << std::sqrt(diff / norm)
+            << "\n";
+  EXPECT_LT(worst, 0.02);                   // measured 0.6%
+  EXPECT_LT(std::sqrt(diff / norm), 0.02);  // measured 0.5% (linear probe)
 }
 
 }  // namespace
