@@ -60,6 +60,9 @@ struct ReductionEntry : ProbeSet::Probe {
     const std::string& q = spec.quantity();
     if (q == "kinetic_energy") return {total_kinetic_energy<D>(p)};
     if (q == "extent") return {extent<D>(p, spec.axis())};
+    if (q == "surface_height")
+      return {
+          surface_height<D>(p, to_vec<D>(spec.at()), spec.axis(), body->kernel.smoothing_length())};
     if (q == "integral") return {integral<D>(p, spec.field())};
     if (q == "total") {
       if (p.info(spec.field()).kind == FieldKind::Scalar) return {total_scalar<D>(p, spec.field())};
@@ -130,12 +133,14 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
       entry->body = body;
       entry->spec = spec.reduce();
       const std::string& q = spec.reduce().quantity();
-      if (q != "kinetic_energy" && q != "extent") {
+      if (q == "surface_height" && spec.reduce().at_size() == 0)
+        throw ConfigError(path + ".reduce.at", "a surface height needs the gauge position 'at'");
+      if (q != "kinetic_energy" && q != "extent" && q != "surface_height") {
         if (spec.reduce().field().empty())
           throw ConfigError(path + ".reduce", "'" + q + "' needs a field");
         check_field(spec.reduce().field(), path + ".reduce.field");
       }
-      if (q == "extent" && spec.reduce().axis() >= D)
+      if ((q == "extent" || q == "surface_height") && spec.reduce().axis() >= D)
         throw ConfigError(path + ".reduce.axis", "axis must be below the dimension");
       if (q == "total" && particles.info(spec.reduce().field()).kind == FieldKind::Vector) {
         for (int a = 0; a < D; ++a)
@@ -143,7 +148,9 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
       } else {
         entry->columns = {
             q == "extent" ? "extent_" + std::string(1, "xyz"[spec.reduce().axis()])
-                          : q + (spec.reduce().field().empty() ? "" : "_" + spec.reduce().field())};
+            : q == "surface_height"
+                ? std::string("surface_height")
+                : q + (spec.reduce().field().empty() ? "" : "_" + spec.reduce().field())};
       }
       return entry;
     }

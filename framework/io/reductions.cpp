@@ -1,6 +1,8 @@
 #include "io/reductions.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "core/parallel.hpp"
@@ -14,6 +16,21 @@ double total_kinetic_energy(const ParticleSet<D>& particles) {
   const auto& v = required_vector(particles, "velocity", "the kinetic energy");
   return deterministic_sum(particles.size(), 0.0,
                            [&](std::size_t i) { return 0.5 * m[i] * v[i].squaredNorm(); });
+}
+
+template <int D>
+double surface_height(const ParticleSet<D>& particles, const Vec<D>& at, int axis,
+                      double half_width) {
+  const auto& x = required_vector(particles, "position", "a surface height");
+  const auto& V = required_scalar(particles, "volume", "a surface height");
+  double top = -INFINITY;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    bool inside = true;
+    for (int a = 0; a < D; ++a)
+      if (a != axis && std::abs(x[i][a] - at[a]) > half_width) inside = false;
+    if (inside) top = std::max(top, x[i][axis] + 0.5 * std::pow(V[i], 1.0 / D));
+  }
+  return std::isfinite(top) ? top : std::numeric_limits<double>::quiet_NaN();
 }
 
 template <int D>
@@ -52,11 +69,12 @@ double integral(const ParticleSet<D>& particles, const std::string& scalar_field
   return deterministic_sum(particles.size(), 0.0, [&](std::size_t i) { return volume[i] * f[i]; });
 }
 
-#define COSPH_INSTANTIATE_REDUCTIONS(D)                                       \
-  template double total_kinetic_energy<D>(const ParticleSet<D>&);             \
-  template double extent<D>(const ParticleSet<D>&, int);                      \
-  template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&); \
-  template double total_scalar<D>(const ParticleSet<D>&, const std::string&); \
+#define COSPH_INSTANTIATE_REDUCTIONS(D)                                                 \
+  template double total_kinetic_energy<D>(const ParticleSet<D>&);                       \
+  template double extent<D>(const ParticleSet<D>&, int);                                \
+  template double surface_height<D>(const ParticleSet<D>&, const Vec<D>&, int, double); \
+  template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&);           \
+  template double total_scalar<D>(const ParticleSet<D>&, const std::string&);           \
   template double integral<D>(const ParticleSet<D>&, const std::string&);
 COSPH_INSTANTIATE_REDUCTIONS(2)
 COSPH_INSTANTIATE_REDUCTIONS(3)

@@ -18,6 +18,13 @@ double total_kinetic_energy(const ParticleSet<D>& particles);
 
 // max - min of the vector field "position" along `axis` (0 <= axis < D; std::invalid_argument
 // otherwise); 0 for an empty set. Throws cosph::RuntimeError if "position" is missing.
+// Free-surface height at a wave gauge: the largest x[axis] + V^(1/D)/2 (the top of the particle)
+// over the particles within `half_width` of the gauge line through `at` along `axis`; NaN when
+// the gauge is dry.
+template <int D>
+double surface_height(const ParticleSet<D>& particles, const Vec<D>& at, int axis,
+                      double half_width);
+
 template <int D>
 double extent(const ParticleSet<D>& particles, int axis);
 
@@ -33,11 +40,12 @@ double total_scalar(const ParticleSet<D>& particles, const std::string& field);
 template <int D>
 double integral(const ParticleSet<D>& particles, const std::string& scalar_field);
 
-#define COSPH_DECLARE_REDUCTIONS(D)                                                  \
-  extern template double total_kinetic_energy<D>(const ParticleSet<D>&);             \
-  extern template double extent<D>(const ParticleSet<D>&, int);                      \
-  extern template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&); \
-  extern template double total_scalar<D>(const ParticleSet<D>&, const std::string&); \
+#define COSPH_DECLARE_REDUCTIONS(D)                                                            \
+  extern template double total_kinetic_energy<D>(const ParticleSet<D>&);                       \
+  extern template double extent<D>(const ParticleSet<D>&, int);                                \
+  extern template double surface_height<D>(const ParticleSet<D>&, const Vec<D>&, int, double); \
+  extern template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&);           \
+  extern template double total_scalar<D>(const ParticleSet<D>&, const std::string&);           \
   extern template double integral<D>(const ParticleSet<D>&, const std::string&);
 COSPH_DECLARE_REDUCTIONS(2)
 COSPH_DECLARE_REDUCTIONS(3)

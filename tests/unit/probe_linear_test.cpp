@@ -13,6 +13,7 @@
 #include "core/particles.hpp"
 #include "driver/simulation.hpp"
 #include "io/probes.hpp"
+#include "io/reductions.hpp"
 #include "kernels/kernel.hpp"
 #include "module_catalogue.hpp"
 #include "neighbour/domain.hpp"
@@ -189,6 +190,23 @@ probes:
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("probes[0].configuration"), std::string::npos) << e.what();
   }
+}
+
+// Wave gauge: the top of the highest particle within the band around the gauge line; NaN when dry.
+TEST(SurfaceHeight, GaugeReadsTheTopOfTheWaterColumnUnderIt) {
+  ParticleSet<2> water("water");
+  const double dp = 0.1;
+  std::vector<Vec<2>> x;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10 - i / 2; ++j)  // a staircase: columns get lower to the right
+      x.push_back(Vec<2>((i + 0.5) * dp, (j + 0.5) * dp));
+  water.resize(x.size());
+  water.add_vector("position") = x;
+  water.add_scalar("volume").assign(x.size(), dp * dp);
+  // Column i = 0 (x = 0.05) holds 10 particles: top at 1.0; column i = 6 holds 7: top at 0.7.
+  EXPECT_NEAR(surface_height<2>(water, Vec<2>(0.05, 0.0), 1, 0.4 * dp), 1.0, 1e-12);
+  EXPECT_NEAR(surface_height<2>(water, Vec<2>(0.65, 0.0), 1, 0.4 * dp), 0.7, 1e-12);
+  EXPECT_TRUE(std::isnan(surface_height<2>(water, Vec<2>(2.0, 0.0), 1, 0.4 * dp)));
 }
 
 }  // namespace

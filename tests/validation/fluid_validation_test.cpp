@@ -1,7 +1,8 @@
 // The fluid against Lobovsky et al.'s (2014) dam-break experiment (bench/reference/
 // lobovsky2014_sensor1.csv): the impact time at pressure sensor 1 and the pressure plateau after
-// the impact, at dp = H/40 (bench/studies/fluid_dambreak_impact.yaml goes to H/80); and the
-// transient Poiseuille flow against its series solution.
+// the impact and the water level at gauge H1, at dp = H/40
+// (bench/studies/fluid_dambreak_impact.yaml goes to H/80); and the transient Poiseuille flow
+// against its series solution.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -34,9 +35,9 @@ Series read_probe(const std::string& file, int column) {
   return s;
 }
 
-Series read_experiment() {
+Series read_experiment(const std::string& file = "lobovsky2014_sensor1.csv") {
   Series s;
-  std::ifstream in(std::string(COSPH_SOURCE_DIR) + "/bench/reference/lobovsky2014_sensor1.csv");
+  std::ifstream in(std::string(COSPH_SOURCE_DIR) + "/bench/reference/" + file);
   std::string line;
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#' || line[0] == 't') continue;
@@ -82,6 +83,20 @@ TEST(FluidValidation, DamBreakImpactAndPlateauAtSensorOneMatchTheExperiment) {
             << "), plateau p/(rho g H) " << plateau << " (experiment " << expected << ")\n";
   EXPECT_NEAR(impact, measured, 0.35);              // measured 0.25 late at H/40, 0.11 at H/80
   EXPECT_NEAR(plateau, expected, 0.25 * expected);  // the hydrostatic-like load after the impact
+
+  // The water level at gauge H1 (x = H), every time unit until the reflected wave returns.
+  const Series gauge = read_probe(options.output_directory + "/gauge_H1.csv", 1);
+  const Series level = read_experiment("lobovsky2014_gauge_H1.csv");
+  for (double t : {1.0, 2.0, 3.0, 4.0}) {
+    auto at = [t](const Series& s) {
+      std::size_t k = 0;
+      while (k + 1 < s.t.size() && s.t[k + 1] <= t) ++k;
+      return s.value[k];
+    };
+    std::cout << "gauge H1 at t = " << t << ": " << at(gauge) << " (experiment " << at(level)
+              << ")\n";
+    EXPECT_NEAR(at(gauge), at(level), 0.05);  // measured within 0.02 H
+  }
 }
 
 // Transient Poiseuille flow between no-slip plates (examples/fluid_poiseuille.yaml): the series
