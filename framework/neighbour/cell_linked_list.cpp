@@ -93,23 +93,38 @@ std::size_t CellLinkedList<D>::linear(const std::array<int, D>& c) const {
 
 namespace {
 
-// Two passes (count, then fill) so that the lists are built in parallel without atomics and come
-// out in the same order whatever the number of threads.
+// One search per particle: fixed blocks of particles (independent of the thread count) collect
+// their neighbours into block-local buffers in parallel; a prefix sum over the blocks then places
+// every block in the CSR arrays. The lists come out in the same order whatever the number of
+// threads, without atomics, and the search runs once instead of the count-then-fill twice.
 template <int D, typename ForEach>
 NeighbourList build_list(std::size_t n, const ForEach& for_each) {
+  constexpr std::size_t kBlock = 128;
+  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  std::vector<std::vector<Index>> found(blocks);
   NeighbourList list;
-  std::vector<std::size_t> count(n);
-  parallel_for_each_index(n, [&](std::size_t i) {
-    std::size_t c = 0;
-    for_each(i, [&](Index) { ++c; });
-    count[i] = c;
-  });
   list.offset.assign(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) list.offset[i + 1] = list.offset[i] + count[i];
+  // One task per block (parallel_for_each_index's grain of 256 would run all blocks in one).
+  const auto each_block = [&](const auto& body) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t b = r.begin(); b != r.end(); ++b) body(b);
+                      });
+  };
+  each_block([&](std::size_t b) {
+    auto& buffer = found[b];
+    const std::size_t end = std::min(n, (b + 1) * kBlock);
+    for (std::size_t i = b * kBlock; i < end; ++i) {
+      const std::size_t before = buffer.size();
+      for_each(i, [&](Index j) { buffer.push_back(j); });
+      list.offset[i + 1] = buffer.size() - before;  // count for now, offsets below
+    }
+  });
+  for (std::size_t i = 0; i < n; ++i) list.offset[i + 1] += list.offset[i];
   list.index.resize(list.offset[n]);
-  parallel_for_each_index(n, [&](std::size_t i) {
-    std::size_t k = list.offset[i];
-    for_each(i, [&](Index j) { list.index[k++] = j; });
+  each_block([&](std::size_t b) {
+    std::copy(found[b].begin(), found[b].end(),
+              list.index.begin() + static_cast<std::ptrdiff_t>(list.offset[b * kBlock]));
   });
   return list;
 }
@@ -129,6 +144,15 @@ template <int D>
 NeighbourList build_contact_list(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,
                                  double cutoff, const Domain<D>& domain) {
   CellLinkedList<D> cells(b, cutoff, domain);
+  constexpr Index none = static_cast<Index>(-1);
+  return build_list<D>(a.size(), [&](std::size_t i, const auto& emit) {
+    cells.for_each_neighbour(a[i], cutoff, none, emit);
+  });
+}
+
+template <int D>
+NeighbourList build_contact_list(const std::vector<Vec<D>>& a, const CellLinkedList<D>& cells,
+                                 double cutoff) {
   constexpr Index none = static_cast<Index>(-1);
   return build_list<D>(a.size(), [&](std::size_t i, const auto& emit) {
     cells.for_each_neighbour(a[i], cutoff, none, emit);
@@ -162,6 +186,8 @@ std::vector<Index> cell_sort_order(const std::vector<Vec<D>>& positions, double 
                                              const Domain<D>&);                                \
   template NeighbourList build_contact_list<D>(                                                \
       const std::vector<Vec<D>>&, const std::vector<Vec<D>>&, double, const Domain<D>&);       \
+  template NeighbourList build_contact_list<D>(const std::vector<Vec<D>>&,                     \
+                                               const CellLinkedList<D>&, double);              \
   template NeighbourList brute_force_list<D>(                                                  \
       const std::vector<Vec<D>>&, const std::vector<Vec<D>>&, double, const Domain<D>&, bool); \
   template std::vector<Index> cell_sort_order<D>(const std::vector<Vec<D>>&, double,           \

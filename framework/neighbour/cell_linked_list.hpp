@@ -56,6 +56,11 @@ template <int D>
 NeighbourList build_contact_list(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,
                                  double cutoff, const Domain<D>& domain);
 
+// The same against a cell list of set b built beforehand (b static: built once, searched often).
+template <int D>
+NeighbourList build_contact_list(const std::vector<Vec<D>>& a, const CellLinkedList<D>& b_cells,
+                                 double cutoff);
+
 // Reference O(N^2) search used by the tests.
 template <int D>
 NeighbourList brute_force_list(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -290,6 +291,7 @@ class FluidModule final : public Module {
     walls_.add_scalar("volume", {.output = true}) = volume;
     walls_.add_vector("velocity", {.output = true});
     wall_owner_ = owner;
+    for (const auto& w : wall_velocity_) walls_move_ = walls_move_ || !w.empty();
     update_wall_velocity(0.0);
   }
 
@@ -306,9 +308,7 @@ class FluidModule final : public Module {
   // Moving walls move with their prescribed velocity (whole advection step, explicit).
   void move_walls(double dt) {
     if (walls_.size() == 0) return;
-    bool moving = false;
-    for (const auto& w : wall_velocity_) moving = moving || !w.empty();
-    if (!moving) return;
+    if (!walls_move_) return;
     update_wall_velocity(time_ + 0.5 * dt);
     auto& x = walls_.vector("position");
     const auto& v = walls_.vector("velocity");
@@ -346,7 +346,9 @@ class FluidModule final : public Module {
     pair_geometry(x, x, inner_, inner_geometry_);
     if (walls_.size() > 0) {
       const auto& wx = walls_.vector("position");
-      contact_ = build_contact_list<D>(x, wx, kernel_.support_radius(), domain_);
+      // Static walls keep their cell list; moving walls rebuild it every step.
+      if (!wall_cells_ || walls_move_) wall_cells_.emplace(wx, kernel_.support_radius(), domain_);
+      contact_ = build_contact_list<D>(x, *wall_cells_, kernel_.support_radius());
       pair_geometry(x, wx, contact_, contact_geometry_);
     }
   }
@@ -574,6 +576,8 @@ class FluidModule final : public Module {
   Vec<D> gravity_ = Vec<D>::Zero();
   double sound_speed_ = 0.0, reference_number_density_ = 1.0;
   NeighbourList inner_, contact_;
+  std::optional<CellLinkedList<D>> wall_cells_;
+  bool walls_move_ = false;
   PairGeometry inner_geometry_, contact_geometry_;
   std::vector<Vec<D>> dv_;
   double time_ = 0.0;

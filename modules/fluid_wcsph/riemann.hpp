@@ -12,18 +12,26 @@
 namespace cosph {
 
 struct RiemannSolver {
-  double impedance;    // Z = rho0 c
-  double sound_speed;  // c
-  bool limited;        // low-dissipation limiter
+  RiemannSolver(double impedance, double sound_speed, bool limited)
+      : impedance_(impedance),
+        limiter_scale_(3.0 / sound_speed),
+        inverse_impedance_(1.0 / impedance),
+        limited_(limited) {}
 
   double pressure(double p_left, double p_right, double u_left, double u_right) const {
     const double jump = u_left - u_right;
-    const double beta = limited ? std::min(3.0 * std::max(jump, 0.0) / sound_speed, 1.0) : 1.0;
-    return 0.5 * (p_left + p_right) + 0.5 * beta * impedance * jump;
+    const double beta = limited_ ? std::min(limiter_scale_ * std::max(jump, 0.0), 1.0) : 1.0;
+    return 0.5 * (p_left + p_right) + 0.5 * beta * impedance_ * jump;
   }
   double velocity(double p_left, double p_right, double u_left, double u_right) const {
-    return 0.5 * (u_left + u_right) + 0.5 * (p_left - p_right) / impedance;
+    return 0.5 * (u_left + u_right) + 0.5 * (p_left - p_right) * inverse_impedance_;
   }
+
+ private:
+  double impedance_;          // Z = rho0 c
+  double limiter_scale_;      // 3 / c
+  double inverse_impedance_;  // 1 / Z
+  bool limited_;              // low-dissipation limiter
 };
 
 }  // namespace cosph
