@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../support/probe_csv.hpp"
 #include "driver/simulation.hpp"
 #include "module_catalogue.hpp"
 
@@ -18,19 +19,7 @@ std::string example(const std::string& name) {
   return std::string(COSPH_SOURCE_DIR) + "/examples/" + name;
 }
 
-std::vector<double> csv_column(const std::string& file, int column) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::vector<double> values;
-  while (std::getline(in, line)) {
-    std::stringstream row(line);
-    std::string cell;
-    for (int c = 0; c <= column; ++c) std::getline(row, cell, ',');
-    values.push_back(std::stod(cell));
-  }
-  return values;
-}
+using test::csv_column;
 
 template <typename Check>
 void run(const std::string& scene, const std::vector<std::string>& overrides,

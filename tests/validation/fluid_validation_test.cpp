@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../support/probe_csv.hpp"
 #include "driver/simulation.hpp"
 #include "module_catalogue.hpp"
 
@@ -20,19 +21,7 @@ struct Series {
 };
 
 Series read_probe(const std::string& file, int column) {
-  Series s;
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    std::stringstream row(line);
-    std::string cell, t;
-    std::getline(row, t, ',');
-    for (int c = 1; c <= column; ++c) std::getline(row, cell, ',');
-    s.t.push_back(std::stod(t));
-    s.value.push_back(cell == "nan" ? NAN : std::stod(cell));
-  }
-  return s;
+  return {test::csv_column(file, 0), test::csv_column(file, column)};
 }
 
 Series read_experiment(const std::string& file = "lobovsky2014_sensor1.csv") {

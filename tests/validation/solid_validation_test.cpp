@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../support/probe_csv.hpp"
 #include "driver/simulation.hpp"
 #include "module_catalogue.hpp"
 
@@ -30,19 +31,7 @@ std::string run_scene(const std::string& scene, const std::vector<std::string>& 
 }
 
 // Column `column` (0 = time) of a probe CSV.
-std::vector<double> csv_column(const std::string& file, int column) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  std::vector<double> values;
-  while (std::getline(in, line)) {
-    std::stringstream row(line);
-    std::string cell;
-    for (int c = 0; c <= column; ++c) std::getline(row, cell, ',');
-    values.push_back(std::stod(cell));
-  }
-  return values;
-}
+using test::csv_column;
 
 // Times where y crosses zero downwards (linear interpolation).
 std::vector<double> downward_crossings(const std::vector<double>& t, const std::vector<double>& y) {
