@@ -125,7 +125,7 @@ class FluidModule final : public Module {
       const double dt =
           std::min(spec_.acoustic_cfl() * h / (sound_speed_ + max_speed()), Dt - done);
       pressure_relaxation(dt);
-      density_relaxation(dt);
+      density_relaxation(time_ + done, dt);
       done += dt;
       ++acoustic_steps_;
     }
@@ -305,11 +305,11 @@ class FluidModule final : public Module {
     }
   }
 
-  // Moving walls move with their prescribed velocity (whole advection step, explicit).
-  void move_walls(double dt) {
-    if (walls_.size() == 0) return;
+  // Moving walls move with their prescribed velocity over the acoustic sub-step [t, t + dt],
+  // taken at its middle.
+  void move_walls(double t, double dt) {
     if (!walls_move_) return;
-    update_wall_velocity(time_ + 0.5 * dt);
+    update_wall_velocity(t + 0.5 * dt);
     auto& x = walls_.vector("position");
     const auto& v = walls_.vector("velocity");
     for (std::size_t i = 0; i < x.size(); ++i) x[i] += dt * v[i];
@@ -523,7 +523,7 @@ class FluidModule final : public Module {
   }
 
   // Second half: position to the end of the step, density rate from U*, density half step.
-  void density_relaxation(double dt) {
+  void density_relaxation(double t, double dt) {
     auto& x = fluid_.vector("position");
     const auto& v = fluid_.vector("velocity");
     auto& rho = fluid_.scalar("density");
@@ -531,7 +531,7 @@ class FluidModule final : public Module {
     auto& drho = fluid_.scalar("density_rate");
     const auto& volume = fluid_.scalar("volume");  // m / rho of the first half
     parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + 0.5 * dt * v[i]); });
-    move_walls(dt);
+    move_walls(t, dt);
     const RiemannSolver solver = riemann();
     const bool walls = walls_.size() > 0;
     const auto& wx = walls_.vector("position");

@@ -57,7 +57,7 @@ class SolidModule final : public StaticBodyModule<D> {
     if (spec_.damping() > 0.0) f.push_back("mass-proportional damping");
     if (spec_.load_ramp_time() > 0.0) f.push_back("load ramp");
     if (spec_.body_force_size() > 0) f.push_back("body force");
-    if (!constraints_.empty() || spec_.constraints_size() > 0) f.push_back("constraints");
+    if (spec_.constraints_size() > 0) f.push_back("constraints");
     if (spec_.pressures_size() > 0) f.push_back("follower pressure (Nanson)");
     if (spec_.has_active_tension()) f.push_back("prescribed active tension");
     if (has_frames()) f.push_back("fibre frames");
