@@ -67,7 +67,9 @@ class FluidModule final : public Module {
     f.push_back("dual-criteria time stepping");
     if (spec_.viscosity() > 0.0) f.push_back("viscosity");
     if (spec_.gravity_size() > 0) f.push_back("gravity");
-    if (spec_.transport_velocity()) f.push_back("transport velocity");
+    if (spec_.transport_velocity())
+      f.push_back("transport velocity (" + std::to_string(spec_.transport_velocity_sweeps()) +
+                  " sweeps)");
     if (spec_.walls_size() > 0) f.push_back("walls (one-sided Riemann)");
     if (domain_.any_periodic()) f.push_back("periodic");
     for (const auto& o : spec_.outputs()) f.push_back("output " + o);
@@ -443,33 +445,39 @@ class FluidModule final : public Module {
     });
   }
 
-  // Shifts particles away from crowded neighbourhoods (confined flows): a background-pressure
-  // transport velocity (seed 003 eq. 11) applied as a position correction 0.2 h^2 per step.
+  // Shifts particles away from crowded neighbourhoods (confined flows): the transport-velocity
+  // correction (seed 003 eq. 11) as a position shift -0.4 h^2 sum_j V_j grad W_ij, a gradient
+  // descent on the number density. A single shift larger than this is unstable (the checkerboard
+  // mode overshoots), so the scene's number of sweeps sets how fast the lattice is regularised.
+  // The neighbour list of the step stays valid: each sweep moves a particle by a small fraction
+  // of h.
   void correct_transport_velocity() {
     auto& x = fluid_.vector("position");
     const auto& volume = fluid_.scalar("volume");
     const double h = kernel_.smoothing_length();
-    std::vector<Vec<D>> shift(x.size(), Vec<D>::Zero());
+    shift_.resize(x.size());
     const bool walls = walls_.size() > 0;
     const auto& wx = walls_.vector("position");
     const auto& wV = walls_.scalar("volume");
-    parallel_for_each_index(x.size(), [&](std::size_t i) {
-      Vec<D> sum = Vec<D>::Zero();
-      for (Index j : inner_.of(i)) {
-        const Vec<D> d = domain_.displacement(x[i], x[j]);
-        const double r = d.norm();
-        if (r > 0.0) sum += volume[j] * kernel_.derivative(r) / r * d;
-      }
-      if (walls) {
-        for (Index w : contact_.of(i)) {
-          const Vec<D> d = domain_.displacement(x[i], wx[w]);
+    for (int sweep = 0; sweep < spec_.transport_velocity_sweeps(); ++sweep) {
+      parallel_for_each_index(x.size(), [&](std::size_t i) {
+        Vec<D> sum = Vec<D>::Zero();
+        for (Index j : inner_.of(i)) {
+          const Vec<D> d = domain_.displacement(x[i], x[j]);
           const double r = d.norm();
-          if (r > 0.0) sum += wV[w] * kernel_.derivative(r) / r * d;
+          if (r > 0.0) sum += volume[j] * kernel_.derivative(r) / r * d;
         }
-      }
-      shift[i] = -0.4 * h * h * sum;
-    });
-    parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift[i]); });
+        if (walls) {
+          for (Index w : contact_.of(i)) {
+            const Vec<D> d = domain_.displacement(x[i], wx[w]);
+            const double r = d.norm();
+            if (r > 0.0) sum += wV[w] * kernel_.derivative(r) / r * d;
+          }
+        }
+        shift_[i] = -0.4 * h * h * sum;
+      });
+      parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift_[i]); });
+    }
   }
 
   Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
@@ -579,7 +587,7 @@ class FluidModule final : public Module {
   std::optional<CellLinkedList<D>> wall_cells_;
   bool walls_move_ = false;
   PairGeometry inner_geometry_, contact_geometry_;
-  std::vector<Vec<D>> dv_;
+  std::vector<Vec<D>> dv_, shift_;
   double time_ = 0.0;
   long long steps_ = 0, acoustic_steps_ = 0;
 };
