@@ -12,6 +12,7 @@ not be written or the best error exceeds --expect-max-error, 2 an invalid study 
 import argparse
 import ast
 import csv
+import hashlib
 import itertools
 import json
 import math
@@ -34,15 +35,21 @@ import matplotlib.pyplot as plt  # noqa: E402
 REPO_ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_COSPH = REPO_ROOT / "build" / "release" / "app" / "cosph"
 
-# period: the mean period of a time series' downward zero crossings (oscillating structures).
-KINDS = ("profile", "time_series", "final", "period")
+# period: the mean period of a time series' downward zero crossings (oscillating structures);
+# mean, maximum, amplitude: one value of a time series (amplitude = (max - min) / 2);
+# dominant_period, dominant_amplitude: the period and amplitude of the strongest sinusoid of a
+# noisy oscillation (the peak of a Hann-windowed, zero-padded spectrum), e.g. the lift of a
+# cylinder shedding vortices under acoustic noise.
+SCALAR_KINDS = ("period", "mean", "maximum", "amplitude", "dominant_period",
+                "dominant_amplitude")
+KINDS = ("profile", "time_series", "final") + SCALAR_KINDS
 # Which quantity kinds each norm makes sense for: a spatial L2 needs a profile, an arrival time
 # needs a time series, a relative error at a point needs a single value.
 NORM_KINDS = {
-    "max": ("profile", "time_series", "final", "period"),
+    "max": ("profile", "time_series", "final") + SCALAR_KINDS,
     "l2_relative": ("profile",),
     "l2_time": ("time_series",),
-    "relative_at_point": ("final", "period"),
+    "relative_at_point": ("final",) + SCALAR_KINDS,
     "arrival_time": ("time_series",),
 }
 NORM_TEXT = {
@@ -95,6 +102,11 @@ class Quantity:
     combine: Optional[str] = None
     combine_code: Any = None
     label: Optional[str] = None  # what the quantity is, for the tables and plots
+    # Time series only: the samples inside [t0, t1], a centred moving average over `smooth`
+    # time units (acoustic noise on forces), and a factor (e.g. force to coefficient).
+    window: Optional[tuple] = None
+    smooth: Optional[float] = None
+    scale: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -295,7 +307,8 @@ def _scene_probes(scene: Path) -> dict:
 
 def _parse_quantity(node: Any, scene: Path) -> Quantity:
     _check_keys(node, "quantity", ("probe", "kind"),
-                ("field", "column", "columns", "combine", "label", "time"))
+                ("field", "column", "columns", "combine", "label", "time", "window", "smooth",
+                 "scale"))
     probe = _string(node["probe"], "quantity.probe")
     kind = node["kind"]
     if kind not in KINDS:
@@ -333,7 +346,35 @@ def _parse_quantity(node: Any, scene: Path) -> Quantity:
     label = node.get("label")
     if label is not None:
         label = _string(label, "quantity.label")
-    return Quantity(probe, kind, field_name, column, when, columns, combine, combine_code, label)
+    window, smooth, scale = _parse_series_options(node, kind)
+    return Quantity(probe, kind, field_name, column, when, columns, combine, combine_code, label,
+                    window, smooth, scale)
+
+
+def _parse_series_options(node: dict, kind: str) -> tuple:
+    """(window, smooth, scale) of a time-series quantity."""
+    series_kinds = ("time_series",) + SCALAR_KINDS
+    for key in ("window", "smooth"):
+        if node.get(key) is not None and kind not in series_kinds:
+            raise StudyError(f"quantity.{key}: only used by a time series ("
+                             + ", ".join(series_kinds) + ")")
+    window = node.get("window")
+    if window is not None:
+        if not isinstance(window, list) or len(window) != 2:
+            raise StudyError("quantity.window: expected [t0, t1]")
+        window = (_number(window[0], "quantity.window[0]"), _number(window[1], "quantity.window[1]"))
+        if not window[0] < window[1]:
+            raise StudyError("quantity.window: expected t0 < t1")
+    smooth = node.get("smooth")
+    if smooth is not None:
+        smooth = _number(smooth, "quantity.smooth")
+        if not smooth > 0:
+            raise StudyError("quantity.smooth: expected a positive time")
+    scale = node.get("scale", 1.0)
+    scale = _number(scale, "quantity.scale")
+    if scale == 0:
+        raise StudyError("quantity.scale: expected a nonzero factor")
+    return window, smooth, scale
 
 
 def _parse_combination(node: dict, kind: str) -> tuple:
@@ -598,12 +639,34 @@ def first_line(text: str) -> str:
     return ""
 
 
+def run_key(cosph: Path, scene: Path, overrides: dict, repeat: int) -> str:
+    """What a run's outputs depend on: the executable's bytes, the scene's text and the
+    overrides (and the number of repeats, whose fastest wall time is reported)."""
+    digest = hashlib.sha256()
+    with open(cosph, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    digest.update(scene.read_bytes())
+    digest.update(json.dumps([[k, format_value(v)] for k, v in overrides.items()]).encode())
+    digest.update(str(repeat).encode())
+    return digest.hexdigest()[:24]
+
+
 def run_point(study: Study, point: Point, cosph: Path, out_dir: Path, repeat: int,
-              timeout: float) -> PointResult:
-    """Runs one point (the fastest of `repeat` runs counts) and compares it with the reference."""
+              timeout: float, cache: Optional[Path] = None) -> PointResult:
+    """Runs one point (the fastest of `repeat` runs counts) and compares it with the reference.
+    With a cache directory, a run with the same executable, scene and overrides (from this or
+    another study) is reused instead of repeated."""
     result = PointResult(point)
     best_summary = None
-    for _ in range(repeat):
+    if cache is not None:
+        out_dir = cache / run_key(cosph, study.scene, point.overrides, repeat)
+        try:
+            best_summary = json.loads((out_dir / "summary.json").read_text())
+            result.message = "reused"
+        except (OSError, ValueError):
+            best_summary = None
+    for _ in range(0 if best_summary is not None else repeat):
         if out_dir.exists():
             shutil.rmtree(out_dir)
         command = cosph_command(cosph, study.scene, point.overrides, out_dir)
@@ -627,6 +690,8 @@ def run_point(study: Study, point: Point, cosph: Path, out_dir: Path, repeat: in
             return result
         if best_summary is None or summary["wall_seconds"] < best_summary["wall_seconds"]:
             best_summary = summary
+    if cache is not None and result.message != "reused":
+        (out_dir / "summary.json").write_text(json.dumps(best_summary))
     for name in ("wall_seconds", "cpu_seconds", "particles", "steps",
                  "particle_steps_per_second", "threads"):
         setattr(result, name, float(best_summary.get(name, math.nan)))
@@ -675,19 +740,74 @@ def extract_sample(quantity: Quantity, out_dir: Path) -> Sample:
         shown = ", ".join(columns[:6]) + (", ..." if len(columns) > 6 else "")
         raise ComparisonError(f"probe '{quantity.probe}' has no column '{quantity.column}' "
                               f"(it has {shown})")
-    series = values[:, columns.index(quantity.column)]
+    series = values[:, columns.index(quantity.column)] * quantity.scale
+    times, series = _prepare_series(quantity, times, series)
     label = quantity.column.split("@", 1)[1] if "@" in quantity.column else None
     origin = next(iter(coordinates.values()), None)
     xyz = coordinates.get(label, (math.nan,) * 3)
     distance = math.dist(xyz, origin) if origin and label in coordinates else math.nan
     if quantity.kind == "period":
         return _period_sample(quantity, times, series, xyz, distance)
+    if quantity.kind in ("mean", "maximum", "amplitude", "dominant_period", "dominant_amplitude"):
+        if quantity.kind.startswith("dominant_"):
+            period, amplitude = dominant_oscillation(times, series)
+            value = period if quantity.kind == "dominant_period" else amplitude
+        else:
+            value = {"mean": np.mean, "maximum": np.max,
+                     "amplitude": lambda s: 0.5 * (np.max(s) - np.min(s))}[quantity.kind](series)
+        t = times[-1:]
+        variables = {"x": np.full_like(t, xyz[0]), "y": np.full_like(t, xyz[1]),
+                     "z": np.full_like(t, xyz[2]), "t": t, "distance": np.full_like(t, distance)}
+        return Sample(np.array([value]), variables, t, "time", quantity.kind)
     if quantity.kind == "final":
         times, series = times[-1:], series[-1:]
     variables = {"x": np.full_like(times, xyz[0]), "y": np.full_like(times, xyz[1]),
                  "z": np.full_like(times, xyz[2]), "t": times,
                  "distance": np.full_like(times, distance)}
     return Sample(series, variables, times, "time", _field_of(quantity.column))
+
+
+def dominant_oscillation(times, series) -> tuple:
+    """(period, amplitude) of the strongest sinusoid in a series: resampled uniformly, mean
+    removed, Hann-windowed and zero-padded 16x so that the peak's frequency is resolved to a
+    small fraction of 1 / duration; the amplitude is 2 |X(f)| / sum(window), exact for a pure
+    sinusoid at a bin."""
+    if len(times) < 8:
+        raise ComparisonError("an oscillation needs at least 8 samples (run longer)")
+    n = len(times)
+    uniform = np.linspace(times[0], times[-1], n)
+    values = np.interp(uniform, times, series)
+    values = values - values.mean()
+    window = np.hanning(n)
+    size = 16 * n
+    spectrum = np.abs(np.fft.rfft(values * window, size))
+    frequencies = np.fft.rfftfreq(size, uniform[1] - uniform[0])
+    # Skip the bins of the window's main lobe at zero frequency (the remaining trend).
+    lowest = 2.0 / (times[-1] - times[0])
+    spectrum[frequencies < lowest] = 0.0
+    peak = int(np.argmax(spectrum))
+    if spectrum[peak] == 0.0:
+        raise ComparisonError("no oscillation: the series is constant over the window")
+    return 1.0 / frequencies[peak], 2.0 * spectrum[peak] / window.sum()
+
+
+def _prepare_series(quantity: Quantity, times, series) -> tuple:
+    """The series smoothed by a centred moving average (over the whole record, so the window's
+    edges are averaged with their neighbours), then cut to the window."""
+    if quantity.smooth is not None and len(times) > 2:
+        dt = float(np.median(np.diff(times)))
+        width = max(1, int(round(quantity.smooth / dt)))
+        if width > 1:
+            kernel = np.ones(width) / width
+            padded = np.pad(series, (width // 2, width - 1 - width // 2), mode="edge")
+            series = np.convolve(padded, kernel, mode="valid")
+    if quantity.window is not None:
+        inside = (times >= quantity.window[0]) & (times <= quantity.window[1])
+        if not inside.any():
+            raise ComparisonError(f"no samples of {quantity.column} in the window "
+                                  f"[{quantity.window[0]:g}, {quantity.window[1]:g}] (run longer)")
+        times, series = times[inside], series[inside]
+    return times, series
 
 
 def _period_sample(quantity: Quantity, times, series, xyz, distance) -> Sample:
@@ -882,10 +1002,27 @@ def quantity_text(quantity: Quantity) -> str:
         when = "last row" if quantity.time == "last" else f"row nearest t = {quantity.time:g}"
         return f"profile, {when}"
     name = f"{quantity.label}: " if quantity.label else ""
+    extra = ""
+    if quantity.scale != 1.0:
+        extra += f" times {quantity.scale:g}"
+    if quantity.smooth is not None:
+        extra += f", moving average over {quantity.smooth:g}"
+    if quantity.window is not None:
+        extra += f", t in [{quantity.window[0]:g}, {quantity.window[1]:g}]"
     if quantity.kind == "time_series":
-        return f"{name}time series of {quantity.column}"
+        return f"{name}time series of {quantity.column}{extra}"
     if quantity.kind == "period":
-        return f"{name}mean period of the downward zero crossings of {quantity.column}"
+        return f"{name}mean period of the downward zero crossings of {quantity.column}{extra}"
+    if quantity.kind == "mean":
+        return f"{name}time mean of {quantity.column}{extra}"
+    if quantity.kind == "maximum":
+        return f"{name}largest value of {quantity.column}{extra}"
+    if quantity.kind == "amplitude":
+        return f"{name}half the peak-to-peak range of {quantity.column}{extra}"
+    if quantity.kind == "dominant_period":
+        return f"{name}period of the strongest sinusoid in {quantity.column}{extra}"
+    if quantity.kind == "dominant_amplitude":
+        return f"{name}amplitude of the strongest sinusoid in {quantity.column}{extra}"
     return f"{name}final value of {quantity.column}"
 
 
@@ -973,7 +1110,7 @@ def _plot_best(ax, study: Study, results: list) -> None:
         ax.set_axis_off()
         return
     sample, reference = best.sample, best.reference_values
-    if study.quantity.kind in ("final", "period"):
+    if study.quantity.kind in ("final",) + SCALAR_KINDS:
         _plot_final_values(ax, study, results)
         return
     every = max(1, len(sample.values) // 40)
@@ -1055,7 +1192,7 @@ class StudyRun:
 
 
 def run_study(study: Study, cosph: Path, out_dir: Path, repeat: int, timeout: float,
-              log: Callable[[str], None] = print) -> StudyRun:
+              log: Callable[[str], None] = print, cache: Optional[Path] = None) -> StudyRun:
     """Runs every point of a study and writes results.csv, table.md and plot.png (OSError when
     one cannot be written)."""
     start = time.monotonic()
@@ -1063,7 +1200,7 @@ def run_study(study: Study, cosph: Path, out_dir: Path, repeat: int, timeout: fl
     results = []
     for point in points:
         result = run_point(study, point, cosph, out_dir / "points" / str(point.index), repeat,
-                           timeout)
+                           timeout, cache)
         results.append(result)
         log(f"[{point.index + 1}/{len(points)}] {point.label}: {result.status}"
             + (f" ({result.message})" if result.message else "")
@@ -1090,6 +1227,9 @@ def parse_args(argv: Optional[list]) -> argparse.Namespace:
                              "study's 'repeat', else 1)")
     parser.add_argument("--timeout", type=float, default=900.0,
                         help="seconds before one run counts as failed (default: %(default)s)")
+    parser.add_argument("--cache", type=Path, metavar="DIR",
+                        help="reuse runs with the same executable, scene and overrides from DIR "
+                             "(and keep new ones there)")
     parser.add_argument("--expect-max-error", type=float, metavar="X",
                         help="exit 1 unless the best point's error is at most X (CI checks)")
     args = parser.parse_args(argv)
@@ -1119,7 +1259,8 @@ def main(argv: Optional[list] = None) -> int:
     print(f"study {study.name}: {len(study.points())} point(s), scene {study.scene}, "
           f"output {out_dir}")
     try:
-        done = run_study(study, cosph, out_dir, repeat, args.timeout)
+        done = run_study(study, cosph, out_dir, repeat, args.timeout,
+                         cache=args.cache.resolve() if args.cache else None)
     except OSError as error:
         print(f"study.py: error: cannot write the results: {error}", file=sys.stderr)
         return 1

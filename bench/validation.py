@@ -4,6 +4,11 @@ default, through bench/study.py) and writes one section per study, with the mach
 commit the numbers come from, and copies each study's plot to docs/validation/<study>.png.
 
 usage: /usr/bin/python3 bench/validation.py [--studies FILE ...] [--cosph PATH] [--repeat N]
+                                           [--fresh]
+
+Runs are kept in bench/results/runs/ under a key of the executable's bytes, the scene and the
+overrides: studies that share a run (the cylinder's drag, lift and period) run it once, and a
+regeneration with an unchanged executable reuses every run (--fresh reruns them).
 
 Exit codes: 0 written (points may have failed: the tables say so), 1 a file could not be
 written, 2 an invalid study file or usage.
@@ -149,7 +154,7 @@ def study_section(number: int, run: studies.StudyRun, doc_dir: Path, image: Path
     lines += ["", "### Reference", ""]
     lines += reference_lines(study, doc_dir)
     right = ("every point's value against its particle count, with the reference"
-             if study.quantity.kind == "final"
+             if study.quantity.kind in ("final",) + studies.SCALAR_KINDS
              else "the reference over the simulated curve of the best point")
     lines += ["", "### Results", "",
               f"Bold: the lowest error. Study run time {run.seconds:.1f} s. "
@@ -224,6 +229,9 @@ def parse_args(argv: Optional[list]) -> argparse.Namespace:
                         help="cosph executable (default: %(default)s)")
     parser.add_argument("--repeat", type=int,
                         help="runs per point (default: each study's 'repeat')")
+    parser.add_argument("--fresh", action="store_true",
+                        help="rerun every point (default: reuse runs of the same executable, "
+                             "scene and overrides kept in bench/results/runs/)")
     parser.add_argument("--output", type=Path, default=DOCS_DIR / "VALIDATION.md",
                         help="document to write (default: %(default)s)")
     args = parser.parse_args(argv)
@@ -262,8 +270,9 @@ def main(argv: Optional[list] = None) -> int:
         for study in loaded:
             print(f"== {study.name} ({len(study.points())} points)")
             out_dir = REPO_ROOT / "bench" / "results" / study.name
+            cache = None if args.fresh else REPO_ROOT / "bench" / "results" / "runs"
             runs.append(studies.run_study(study, cosph, out_dir, args.repeat or study.repeat,
-                                          timeout=900.0))
+                                          timeout=900.0, cache=cache))
         write_document(args.output.resolve(), runs, machine, time.monotonic() - start)
     except OSError as error:
         print(f"validation.py: error: cannot write: {error}", file=sys.stderr)

@@ -152,6 +152,21 @@ void ParticleSet<D>::permute(const std::vector<Index>& order) {
         s);
 }
 
+template <int D>
+void ParticleSet<D>::select(const std::vector<Index>& from) {
+  for (Index i : from)
+    if (i >= size_) throw std::logic_error("selection of a particle beyond the set");
+  for (auto& s : data_)
+    std::visit(
+        [&](auto& v) {
+          auto copy = v;
+          v.resize(from.size());
+          for (std::size_t i = 0; i < from.size(); ++i) v[i] = copy[from[i]];
+        },
+        s);
+  size_ = from.size();
+}
+
 template class ParticleSet<2>;
 template class ParticleSet<3>;
 

@@ -70,6 +70,10 @@ class ParticleSet {
 
   // Reorders every field: new[i] = old[order[i]]. Used by the cell sort for memory locality.
   void permute(const std::vector<Index>& order);
+  // The set becomes the particles at these indices, in this order (repeats copy a particle,
+  // omissions remove it): the size changes to from.size(). Open boundaries add and remove
+  // particles through it.
+  void select(const std::vector<Index>& from);
 
  private:
   int find(const std::string& name) const;

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "driver/scene_geometry.hpp"
 #include "io/csv_time_series.hpp"
 #include "io/probes.hpp"
@@ -65,6 +66,7 @@ struct ReductionEntry : ProbeSet::Probe {
           surface_height<D>(p, to_vec<D>(spec.at()), spec.axis(), body->kernel.smoothing_length())};
     if (q == "integral") return {integral<D>(p, spec.field())};
     if (q == "total") {
+      if (spec.has_within()) return total_within(p);
       if (p.info(spec.field()).kind == FieldKind::Scalar) return {total_scalar<D>(p, spec.field())};
       const Vec<D> v = total_vector<D>(p, spec.field());
       return std::vector<double>(v.data(), v.data() + D);
@@ -73,6 +75,26 @@ struct ReductionEntry : ProbeSet::Probe {
     double m = q == "minimum" ? INFINITY : -INFINITY;
     for (double v : f) m = q == "minimum" ? std::min(m, v) : std::max(m, v);
     return {m};
+  }
+  // The total over the particles inside the `within` box, summed in index order.
+  std::vector<double> total_within(const ParticleSet<D>& p) const {
+    const Vec<D> lower = to_vec<D>(spec.within().lower()), upper = to_vec<D>(spec.within().upper());
+    const auto& x = p.vector("position");
+    auto inside = [&](std::size_t i) {
+      for (int a = 0; a < D; ++a)
+        if (x[i][a] < lower[a] || x[i][a] > upper[a]) return false;
+      return true;
+    };
+    if (p.info(spec.field()).kind == FieldKind::Scalar) {
+      const auto& f = p.scalar(spec.field());
+      return {
+          deterministic_sum(p.size(), 0.0, [&](std::size_t i) { return inside(i) ? f[i] : 0.0; })};
+    }
+    const auto& f = p.vector(spec.field());
+    const Vec<D> v = deterministic_sum(p.size(), Vec<D>(Vec<D>::Zero()), [&](std::size_t i) {
+      return inside(i) ? f[i] : Vec<D>(Vec<D>::Zero());
+    });
+    return std::vector<double>(v.data(), v.data() + D);
   }
 };
 
@@ -140,6 +162,8 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
           throw ConfigError(path + ".reduce", "'" + q + "' needs a field");
         check_field(spec.reduce().field(), path + ".reduce.field");
       }
+      if (spec.reduce().has_within() && q != "total")
+        throw ConfigError(path + ".reduce.within", "only a 'total' takes a box");
       if ((q == "extent" || q == "surface_height") && spec.reduce().axis() >= D)
         throw ConfigError(path + ".reduce.axis", "axis must be below the dimension");
       if (q == "total" && particles.info(spec.reduce().field()).kind == FieldKind::Vector) {

@@ -45,6 +45,23 @@ class FluidModule final : public Module {
       initial_velocity_.push_back(
           parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));
     initial_pressure_ = parse(spec_.initial_pressure(), key_ + ".initial_pressure");
+    if (spec_.has_inflow()) {
+      const auto& in = spec_.inflow();
+      const std::string path = key_ + ".inflow";
+      if (in.axis() >= D) throw ConfigError(path + ".axis", "axis must be below the dimension");
+      for (int a = 0; a < in.velocity_size(); ++a)
+        inflow_velocity_.push_back(
+            parse_field(in.velocity(a), path + ".velocity[" + std::to_string(a) + "]"));
+      buffer_lower_ = to_vec<D>(in.buffer().lower());
+      buffer_upper_ = to_vec<D>(in.buffer().upper());
+      const double length = buffer_upper_[in.axis()] - buffer_lower_[in.axis()];
+      if (!(length >= kernel_.support_radius()))
+        throw ConfigError(path + ".buffer", "the buffer must be at least one kernel support (" +
+                                                std::to_string(kernel_.support_radius()) +
+                                                ") long along the axis");
+    }
+    if (spec_.has_outflow() && spec_.outflow().axis() >= D)
+      throw ConfigError(key_ + ".outflow.axis", "axis must be below the dimension");
     for (int k = 0; k < spec_.walls_size(); ++k) {
       std::vector<Expression> velocity;
       for (int a = 0; a < spec_.walls(k).velocity_size(); ++a)
@@ -71,6 +88,8 @@ class FluidModule final : public Module {
       f.push_back("transport velocity (" + std::to_string(spec_.transport_velocity_sweeps()) +
                   " sweeps)");
     if (spec_.walls_size() > 0) f.push_back("walls (one-sided Riemann)");
+    if (spec_.has_inflow()) f.push_back("inflow buffer");
+    if (spec_.has_outflow()) f.push_back("outflow");
     if (domain_.any_periodic()) f.push_back("periodic");
     for (const auto& o : spec_.outputs()) f.push_back("output " + o);
     return info;
@@ -90,6 +109,7 @@ class FluidModule final : public Module {
     fluid_.add_scalar("density_rate", {.checkpoint = true});
     fluid_.add_vector("acceleration");
     if (has_output("vorticity")) fluid_.add_scalar("vorticity", {.output = true});
+    if (spec_.has_inflow()) fluid_.add_scalar("in_buffer", {.checkpoint = true});
     const double rho0 = spec_.density(), c2 = sound_speed_ * sound_speed_;
     for (std::size_t i = 0; i < n; ++i) {
       x[i] = domain_.any_periodic() ? domain_.wrap(cloud.positions[i]) : cloud.positions[i];
@@ -100,6 +120,11 @@ class FluidModule final : public Module {
       volume[i] = m[i] / rho[i];
       for (int a = 0; a < D && !initial_velocity_.empty(); ++a)
         v[i][a] = initial_velocity_[a].evaluate(point);
+    }
+    if (spec_.has_inflow()) {
+      auto& buffer = fluid_.scalar("in_buffer");
+      for (std::size_t i = 0; i < n; ++i) buffer[i] = inside_buffer(x[i]) ? 1.0 : 0.0;
+      impose_inflow(0.0);
     }
     sort_by_cell();
     build_walls();
@@ -126,11 +151,12 @@ class FluidModule final : public Module {
     while (done < Dt * (1.0 - 1e-12)) {
       const double dt =
           std::min(spec_.acoustic_cfl() * h / (sound_speed_ + max_speed()), Dt - done);
-      pressure_relaxation(dt);
+      pressure_relaxation(time_ + done, dt);
       density_relaxation(time_ + done, dt);
       done += dt;
       ++acoustic_steps_;
     }
+    if (spec_.has_inflow() || spec_.has_outflow()) update_open_boundaries();
     update_volumes();
     time_ += Dt;
     ++steps_;
@@ -139,6 +165,7 @@ class FluidModule final : public Module {
   double time() const override { return time_; }
 
   void prepare_output() override {
+    if (walls_.has("force")) compute_wall_force();
     if (!fluid_.has("vorticity")) return;
     if constexpr (D == 2) {
       const auto& x = fluid_.vector("position");
@@ -168,7 +195,7 @@ class FluidModule final : public Module {
   }
 
   void save(StateRecord& state) const override {
-    for (const char* f : {"position", "velocity", "density", "density_rate", "mass"}) {
+    for (const std::string& f : checkpointed()) {
       const auto raw = fluid_.raw(f);
       state.arrays[f].assign(raw.begin(), raw.end());
     }
@@ -178,7 +205,10 @@ class FluidModule final : public Module {
   }
 
   void load(const StateRecord& state) override {
-    for (const char* f : {"position", "velocity", "density", "density_rate", "mass"}) {
+    // Open boundaries change the particle count: the checkpoint's count is the one to restore.
+    if (auto it = state.arrays.find("mass"); it != state.arrays.end())
+      fluid_.resize(it->second.size());
+    for (const std::string& f : checkpointed()) {
       auto it = state.arrays.find(f);
       auto raw = fluid_.raw(f);
       if (it == state.arrays.end() || it->second.size() != raw.size())
@@ -227,6 +257,18 @@ class FluidModule final : public Module {
     } catch (const ExpressionError& e) {
       throw ConfigError(key, e.what());
     }
+  }
+  static Expression parse_field(const std::string& text, const std::string& key) {
+    try {
+      return Expression::parse(text, {"x", "y", "z", "t"});
+    } catch (const ExpressionError& e) {
+      throw ConfigError(key, e.what());
+    }
+  }
+  std::vector<std::string> checkpointed() const {
+    std::vector<std::string> f{"position", "velocity", "density", "density_rate", "mass"};
+    if (spec_.has_inflow()) f.push_back("in_buffer");
+    return f;
   }
   static Expression parse_time(const std::string& text, const std::string& key) {
     try {
@@ -292,6 +334,7 @@ class FluidModule final : public Module {
     walls_.add_vector("position", {.output = true}) = x;
     walls_.add_scalar("volume", {.output = true}) = volume;
     walls_.add_vector("velocity", {.output = true});
+    if (has_output("wall_force")) walls_.add_vector("force", {.output = true});
     wall_owner_ = owner;
     for (const auto& w : wall_velocity_) walls_move_ = walls_move_ || !w.empty();
     update_wall_velocity(0.0);
@@ -392,7 +435,7 @@ class FluidModule final : public Module {
         for (Index w : contact_.of(i))
           sigma += (*wv)[w] * kernel_.value(domain_.displacement(x[i], (*wx)[w]).norm());
       const double summed = rho0 * sigma / sigma0;
-      rho[i] = free_surface ? std::max(rho[i], summed) : summed;
+      rho[i] = free_surface || near_open_boundary(i) ? std::max(rho[i], summed) : summed;
     });
     update_pressure();
   }
@@ -474,16 +517,116 @@ class FluidModule final : public Module {
             if (r > 0.0) sum += wV[w] * kernel_.derivative(r) / r * d;
           }
         }
-        shift_[i] = -0.4 * h * h * sum;
+        shift_[i] = near_open_boundary(i) ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
       });
       parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift_[i]); });
     }
   }
 
+  bool inside_buffer(const Vec<D>& x) const {
+    for (int a = 0; a < D; ++a)
+      if (x[a] < buffer_lower_[a] || x[a] > buffer_upper_[a]) return false;
+    return true;
+  }
+
+  // Inflow-buffer particles, and particles within one kernel support of the outflow plane, have
+  // truncated neighbourhoods: their summed density would be too low (a spurious suction), so they
+  // keep the larger of the summed and the continuity density, and the transport-velocity shift,
+  // which would push them out of the fluid, leaves them alone.
+  bool near_open_boundary(std::size_t i) const {
+    if (spec_.has_inflow() && fluid_.scalar("in_buffer")[i] > 0.0) return true;
+    if (spec_.has_outflow()) {
+      const auto& out = spec_.outflow();
+      if (fluid_.vector("position")[i][out.axis()] > out.position() - kernel_.support_radius())
+        return true;
+    }
+    return false;
+  }
+
+  void impose_inflow(double t) {
+    const auto& x = fluid_.vector("position");
+    auto& v = fluid_.vector("velocity");
+    const auto& buffer = fluid_.scalar("in_buffer");
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      if (buffer[i] == 0.0) continue;
+      const auto p = space(x[i]);
+      for (int a = 0; a < D; ++a) v[i][a] = inflow_velocity_[a].evaluate({p[0], p[1], p[2], t});
+    }
+  }
+
+  // Once per advection step: particles past the outflow plane leave; a buffer particle that has
+  // left its box downstream becomes free and a copy of it re-enters one buffer length upstream.
+  // The survivors keep their order and the new particles go to the end, so the result does not
+  // depend on the thread count.
+  void update_open_boundaries() {
+    const std::size_t n = fluid_.size();
+    const auto& x = fluid_.vector("position");
+    std::vector<Index> keep, spawn;
+    keep.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (spec_.has_outflow() && x[i][spec_.outflow().axis()] > spec_.outflow().position())
+        continue;
+      keep.push_back(Index(i));
+      if (spec_.has_inflow() && fluid_.scalar("in_buffer")[i] > 0.0 &&
+          x[i][spec_.inflow().axis()] > buffer_upper_[spec_.inflow().axis()])
+        spawn.push_back(Index(i));
+    }
+    if (keep.size() == n && spawn.empty()) return;
+    const std::size_t survivors = keep.size();
+    keep.insert(keep.end(), spawn.begin(), spawn.end());
+    fluid_.select(keep);
+    if (spawn.empty()) return;
+    const int axis = spec_.inflow().axis();
+    const double length = buffer_upper_[axis] - buffer_lower_[axis];
+    auto& position = fluid_.vector("position");
+    auto& buffer = fluid_.scalar("in_buffer");
+    for (std::size_t i = 0; i < survivors; ++i)
+      if (buffer[i] > 0.0 && position[i][axis] > buffer_upper_[axis]) buffer[i] = 0.0;
+    for (std::size_t i = survivors; i < position.size(); ++i) {
+      position[i][axis] -= length;
+      buffer[i] = 1.0;
+    }
+    impose_inflow(time_ + 0.0);
+  }
+
+  // The force of the fluid on each wall particle, the reaction to the wall terms of the fluid's
+  // momentum equation: pressure 2 V_i V_w P* |dW| e_iw and viscosity 4 eta V_i V_w |dW|/r
+  // (v_i - v_w), gathered over the fluid neighbours of each wall particle.
+  void compute_wall_force() {
+    auto& force = walls_.vector("force");
+    const auto& wx = walls_.vector("position");
+    const auto& wv = walls_.vector("velocity");
+    const auto& wV = walls_.scalar("volume");
+    const auto& x = fluid_.vector("position");
+    const auto& v = fluid_.vector("velocity");
+    const auto& rho = fluid_.scalar("density");
+    const auto& p = fluid_.scalar("pressure");
+    const auto& volume = fluid_.scalar("volume");
+    const double eta = spec_.viscosity(), support = kernel_.support_radius();
+    const CellLinkedList<D> cells(x, support, domain_);
+    const RiemannSolver solver = riemann();
+    parallel_for_each_index(wx.size(), [&](std::size_t w) {
+      Vec<D> sum = Vec<D>::Zero();
+      cells.for_each_neighbour(wx[w], support, Index(-1), [&](Index i) {
+        const Vec<D> d = domain_.displacement(wx[w], x[i]);  // from fluid i to wall w
+        const double r = d.norm();
+        if (r <= 0.0 || r >= support) return;
+        const Vec<D> e = d / r;
+        const double g = -kernel_.derivative(r);
+        const Vec<D> mirrored = 2.0 * wv[w] - v[i];
+        const double p_wall = p[i] + rho[i] * gravity_.dot(d);
+        const double P = solver.pressure(p[i], p_wall, v[i].dot(e), mirrored.dot(e));
+        sum += (2.0 * volume[i] * wV[w] * P * g) * e;
+        if (eta > 0.0) sum += (4.0 * eta * volume[i] * wV[w] * g / r) * (v[i] - wv[w]);
+      });
+      force[w] = sum;
+    });
+  }
+
   Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
 
   // First half: density and position to mid-step, velocity over the step from P*.
-  void pressure_relaxation(double dt) {
+  void pressure_relaxation(double t, double dt) {
     auto& x = fluid_.vector("position");
     auto& v = fluid_.vector("velocity");
     auto& rho = fluid_.scalar("density");
@@ -528,6 +671,7 @@ class FluidModule final : public Module {
       dv_[i] = (2.0 / rho[i]) * sum;
     });
     parallel_for_each_index(x.size(), [&](std::size_t i) { v[i] += dt * (dv_[i] + prior[i]); });
+    if (spec_.has_inflow()) impose_inflow(t + dt);
   }
 
   // Second half: position to the end of the step, density rate from U*, density half step.
@@ -579,7 +723,8 @@ class FluidModule final : public Module {
   ParticleSet<D> fluid_, walls_;
   std::vector<int> wall_owner_;
   std::vector<std::vector<Expression>> wall_velocity_;
-  std::vector<Expression> initial_velocity_;
+  std::vector<Expression> initial_velocity_, inflow_velocity_;
+  Vec<D> buffer_lower_ = Vec<D>::Zero(), buffer_upper_ = Vec<D>::Zero();
   Expression initial_pressure_;
   Vec<D> gravity_ = Vec<D>::Zero();
   double sound_speed_ = 0.0, reference_number_density_ = 1.0;

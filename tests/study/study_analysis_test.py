@@ -1,0 +1,66 @@
+#!/usr/bin/python3
+"""Unit tests of bench/study.py's time-series analysis: the dominant oscillation of a noisy
+signal, the smoothing and window of a quantity, and the run key of the run cache."""
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+import study  # noqa: E402
+
+
+def quantity(**options):
+    return study.Quantity(probe="p", kind=options.pop("kind", "time_series"), field=None,
+                          column="c", time="last", **options)
+
+
+class DominantOscillation(unittest.TestCase):
+    def test_finds_period_and_amplitude_under_noise_and_offset(self):
+        t = np.linspace(0.0, 3.0, 601)
+        signal = 1.3 * np.sin(2 * np.pi * t / 0.3337 + 0.4) + 0.1
+        noise = 0.3 * np.sin(2 * np.pi * 60.0 * t)
+        period, amplitude = study.dominant_oscillation(t, signal + noise)
+        self.assertAlmostEqual(period, 0.3337, delta=0.002)
+        self.assertAlmostEqual(amplitude, 1.3, delta=0.02)
+
+    def test_constant_series_is_refused(self):
+        with self.assertRaises(study.ComparisonError):
+            study.dominant_oscillation(np.linspace(0, 1, 50), np.ones(50))
+
+
+class SeriesPreparation(unittest.TestCase):
+    def test_window_cuts_and_smoothing_averages(self):
+        t = np.arange(0.0, 1.0001, 0.01)
+        series = np.where(np.arange(t.size) % 2 == 0, 1.0, -1.0)  # alternating noise
+        times, values = study._prepare_series(quantity(smooth=0.02, window=(0.2, 0.8)), t, series)
+        self.assertAlmostEqual(times[0], 0.2)
+        self.assertAlmostEqual(times[-1], 0.8)
+        self.assertTrue(np.all(np.abs(values) < 1e-12))  # a 2-sample average removes it
+
+    def test_empty_window_is_an_error(self):
+        with self.assertRaises(study.ComparisonError):
+            study._prepare_series(quantity(window=(5.0, 6.0)), np.linspace(0, 1, 11),
+                                  np.zeros(11))
+
+
+class RunKey(unittest.TestCase):
+    def test_depends_on_executable_scene_and_overrides(self):
+        with tempfile.TemporaryDirectory() as directory:
+            exe, scene = Path(directory) / "cosph", Path(directory) / "scene.yaml"
+            exe.write_bytes(b"binary 1")
+            scene.write_text("end_time: 1\n")
+            key = study.run_key(exe, scene, {"a": 1}, 1)
+            self.assertEqual(key, study.run_key(exe, scene, {"a": 1}, 1))
+            self.assertNotEqual(key, study.run_key(exe, scene, {"a": 2}, 1))
+            scene.write_text("end_time: 2\n")
+            self.assertNotEqual(key, study.run_key(exe, scene, {"a": 1}, 1))
+            scene.write_text("end_time: 1\n")
+            exe.write_bytes(b"binary 2")
+            self.assertNotEqual(key, study.run_key(exe, scene, {"a": 1}, 1))
+
+
+if __name__ == "__main__":
+    unittest.main()
