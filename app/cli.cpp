@@ -133,7 +133,7 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const RunSummary summary = simulation.run();
     out << "steps " << summary.steps << "  particles " << summary.particles << "  wall "
         << summary.wall_seconds << " s  particle-steps/s " << summary.particle_steps_per_second
-        << "\n";
+        << "  peak memory " << summary.peak_memory_bytes / 1048576.0 << " MiB\n";
     for (const auto& m : summary.modules) {
       out << "module " << m.name << " (" << m.type << "):";
       for (const auto& f : m.features) out << " [" << f << "]";

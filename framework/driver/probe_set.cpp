@@ -61,6 +61,7 @@ struct ReductionEntry : ProbeSet::Probe {
     const std::string& q = spec.quantity();
     if (q == "kinetic_energy") return {total_kinetic_energy<D>(p)};
     if (q == "extent") return {extent<D>(p, spec.axis())};
+    if (q == "front") return {front<D>(p, spec.axis())};
     if (q == "surface_height")
       return {
           surface_height<D>(p, to_vec<D>(spec.at()), spec.axis(), body->kernel.smoothing_length())};
@@ -157,21 +158,22 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
       const std::string& q = spec.reduce().quantity();
       if (q == "surface_height" && spec.reduce().at_size() == 0)
         throw ConfigError(path + ".reduce.at", "a surface height needs the gauge position 'at'");
-      if (q != "kinetic_energy" && q != "extent" && q != "surface_height") {
+      if (q != "kinetic_energy" && q != "extent" && q != "front" && q != "surface_height") {
         if (spec.reduce().field().empty())
           throw ConfigError(path + ".reduce", "'" + q + "' needs a field");
         check_field(spec.reduce().field(), path + ".reduce.field");
       }
       if (spec.reduce().has_within() && q != "total")
         throw ConfigError(path + ".reduce.within", "only a 'total' takes a box");
-      if ((q == "extent" || q == "surface_height") && spec.reduce().axis() >= D)
+      if ((q == "extent" || q == "front" || q == "surface_height") && spec.reduce().axis() >= D)
         throw ConfigError(path + ".reduce.axis", "axis must be below the dimension");
       if (q == "total" && particles.info(spec.reduce().field()).kind == FieldKind::Vector) {
         for (int a = 0; a < D; ++a)
           entry->columns.push_back(spec.reduce().field() + "." + "xyz"[a]);
       } else {
         entry->columns = {
-            q == "extent" ? "extent_" + std::string(1, "xyz"[spec.reduce().axis()])
+            q == "extent"  ? "extent_" + std::string(1, "xyz"[spec.reduce().axis()])
+            : q == "front" ? "front_" + std::string(1, "xyz"[spec.reduce().axis()])
             : q == "surface_height"
                 ? std::string("surface_height")
                 : q + (spec.reduce().field().empty() ? "" : "_" + spec.reduce().field())};

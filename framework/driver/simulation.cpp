@@ -1,5 +1,6 @@
 #include "driver/simulation.hpp"
 
+#include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <unistd.h>
@@ -60,6 +61,13 @@ std::string json_number(double v) {
   return s.str();
 }
 
+// The process's peak resident memory (Linux reports ru_maxrss in kiB).
+double peak_resident_bytes() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+  return double(usage.ru_maxrss) * 1024.0;
+}
+
 std::string fingerprint(const proto::Scene& scene) {
   std::string bytes = std::to_string(scene.dimension());
   for (const auto& m : scene.modules()) bytes += m.SerializeAsString();
@@ -83,6 +91,7 @@ std::string RunSummary::to_json() const {
   j << "  \"wall_seconds\": " << json_number(wall_seconds) << ",\n";
   j << "  \"cpu_seconds\": " << json_number(cpu_seconds) << ",\n";
   j << "  \"output_seconds\": " << json_number(output_seconds) << ",\n";
+  j << "  \"peak_memory_bytes\": " << json_number(peak_memory_bytes) << ",\n";
   j << "  \"particles\": " << particles << ",\n";
   j << "  \"particle_steps_per_second\": " << json_number(particle_steps_per_second) << ",\n";
   j << "  \"output_directory\": \"" << json_escape(output_directory) << "\",\n";
@@ -431,6 +440,7 @@ RunSummary Simulation::run() {
   summary.wall_seconds = seconds_since(wall_start);
   summary.cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   summary.output_seconds = I.output_seconds;
+  summary.peak_memory_bytes = peak_resident_bytes();
   summary.output_directory = I.directory;
   for (std::size_t k = 0; k < modules_.size(); ++k) {
     const ModuleInfo info = modules_[k]->info();

@@ -42,6 +42,7 @@ struct RunSummary {
   double wall_seconds = 0.0;
   double cpu_seconds = 0.0;
   double output_seconds = 0.0;
+  double peak_memory_bytes = 0.0;  // the process's peak resident set (getrusage ru_maxrss)
   std::size_t particles = 0;
   double particle_steps_per_second = 0.0;
   std::vector<ModuleTiming> modules;

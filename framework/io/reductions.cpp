@@ -34,6 +34,18 @@ double surface_height(const ParticleSet<D>& particles, const Vec<D>& at, int axi
 }
 
 template <int D>
+double front(const ParticleSet<D>& particles, int axis) {
+  if (axis < 0 || axis >= D)
+    throw std::invalid_argument("front: axis " + std::to_string(axis) + " out of range");
+  const auto& x = required_vector(particles, "position", "a front position");
+  const auto& V = required_scalar(particles, "volume", "a front position");
+  double far = -INFINITY;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    far = std::max(far, x[i][axis] + 0.5 * std::pow(V[i], 1.0 / D));
+  return std::isfinite(far) ? far : std::numeric_limits<double>::quiet_NaN();
+}
+
+template <int D>
 double extent(const ParticleSet<D>& particles, int axis) {
   if (axis < 0 || axis >= D)
     throw std::invalid_argument("extent: axis " + std::to_string(axis) + " out of range");
@@ -72,6 +84,7 @@ double integral(const ParticleSet<D>& particles, const std::string& scalar_field
 #define COSPH_INSTANTIATE_REDUCTIONS(D)                                                 \
   template double total_kinetic_energy<D>(const ParticleSet<D>&);                       \
   template double extent<D>(const ParticleSet<D>&, int);                                \
+  template double front<D>(const ParticleSet<D>&, int);                                 \
   template double surface_height<D>(const ParticleSet<D>&, const Vec<D>&, int, double); \
   template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&);           \
   template double total_scalar<D>(const ParticleSet<D>&, const std::string&);           \

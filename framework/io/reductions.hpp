@@ -25,6 +25,11 @@ template <int D>
 double surface_height(const ParticleSet<D>& particles, const Vec<D>& at, int axis,
                       double half_width);
 
+// The leading edge of a body along +axis: the largest coordinate plus half a particle's size
+// (V^(1/D) / 2), e.g. the surge front of a dam break.
+template <int D>
+double front(const ParticleSet<D>& particles, int axis);
+
 template <int D>
 double extent(const ParticleSet<D>& particles, int axis);
 
@@ -43,6 +48,7 @@ double integral(const ParticleSet<D>& particles, const std::string& scalar_field
 #define COSPH_DECLARE_REDUCTIONS(D)                                                            \
   extern template double total_kinetic_energy<D>(const ParticleSet<D>&);                       \
   extern template double extent<D>(const ParticleSet<D>&, int);                                \
+  extern template double front<D>(const ParticleSet<D>&, int);                                 \
   extern template double surface_height<D>(const ParticleSet<D>&, const Vec<D>&, int, double); \
   extern template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&);           \
   extern template double total_scalar<D>(const ParticleSet<D>&, const std::string&);           \

@@ -3,7 +3,7 @@
 // the impact and the water level at gauge H1, at dp = H/40
 // (bench/studies/fluid_dambreak_impact.yaml goes to H/80); and the transient Poiseuille flow
 // against its series solution; the Taylor-Green vortex against its analytic decay, with and
-// without the transport-velocity shift.
+// without the transport-velocity shift; vortex shedding behind a cylinder at Re = 100.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -182,6 +182,56 @@ TEST(FluidValidation, TaylorGreenWithoutTransportVelocityFollowsTheDecayUntilThe
             << ", final / analytic " << run.final_ratio << "\n";
   EXPECT_LT(run.l2_error, 0.03);            // measured 0.010
   EXPECT_NEAR(run.final_ratio, 1.0, 0.05);  // measured 0.975
+}
+
+// Channel flow past a cylinder at Re = 100 (Schaefer & Turek 2D-2) at D/10, through an inflow
+// buffer and an outflow plane: the vortex street's frequency, the mean drag and the lift
+// amplitude over t = 4-6, when the shedding has settled. The lift carries acoustic noise, so its
+// frequency and amplitude are those of the strongest sinusoid (a scan of the Fourier projection
+// over 1-6 Hz). bench/studies/fluid_cylinder_*.yaml: at D/20, St 0.293, C_D 3.35, C_L 0.86.
+TEST(FluidValidation, CylinderSheddingAtRe100MatchesTheBenchmark) {
+  RunOptions options;
+  options.progress = false;
+  options.output_directory = testing::TempDir() + "cosph_fluid_cylinder";
+  const std::string scene = std::string(COSPH_SOURCE_DIR) + "/examples/fluid_cylinder_re100.yaml";
+  Simulation simulation(load_scene_file(scene, {"end_time=6", "output.vtp=false"}),
+                        builtin_modules(), options);
+  simulation.initialize();
+  simulation.run();
+  const std::string file = options.output_directory + "/cylinder_force.csv";
+  const auto t = test::csv_column(file, 0), fx = test::csv_column(file, 1),
+             fy = test::csv_column(file, 2);
+  std::vector<double> time, drag, lift;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] >= 4.0) {
+      time.push_back(t[k]);
+      drag.push_back(20.0 * fx[k]);  // C = 2 F / (rho U^2 D), U = 1, D = 0.1
+      lift.push_back(20.0 * fy[k]);
+    }
+  ASSERT_GT(time.size(), 300u);
+  double mean_drag = 0.0, mean_lift = 0.0;
+  for (std::size_t k = 0; k < time.size(); ++k) {
+    mean_drag += drag[k] / time.size();
+    mean_lift += lift[k] / time.size();
+  }
+  const double pi = std::acos(-1.0);
+  double best_f = 0.0, best_amplitude = 0.0;
+  for (double f = 1.0; f <= 6.0; f += 0.005) {
+    double c = 0.0, s = 0.0;
+    for (std::size_t k = 0; k < time.size(); ++k) {
+      c += (lift[k] - mean_lift) * std::cos(2.0 * pi * f * time[k]);
+      s += (lift[k] - mean_lift) * std::sin(2.0 * pi * f * time[k]);
+    }
+    const double amplitude = 2.0 * std::hypot(c, s) / time.size();
+    if (amplitude > best_amplitude) best_f = f, best_amplitude = amplitude;
+  }
+  const double strouhal = best_f * 0.1;
+  std::cout << "cylinder, D/10: St " << strouhal << " (0.295-0.305), mean C_D " << mean_drag
+            << " (largest 3.22-3.24), C_L amplitude " << best_amplitude << " (0.99-1.01)\n";
+  EXPECT_NEAR(strouhal, 0.30, 0.12 * 0.30);   // measured 0.272
+  EXPECT_NEAR(mean_drag, 3.23, 0.15 * 3.23);  // measured 3.58
+  EXPECT_GT(best_amplitude, 0.4);             // measured 0.60: the street has formed
+  EXPECT_LT(best_amplitude, 1.3);
 }
 
 }  // namespace
