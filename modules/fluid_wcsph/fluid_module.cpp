@@ -9,6 +9,7 @@
 #include "core/parallel.hpp"
 #include "driver/scene_geometry.hpp"
 #include "expression/expression.hpp"
+#include "fluid_wcsph/boundary_set.hpp"
 #include "fluid_wcsph/riemann.hpp"
 #include "geometry/lattice.hpp"
 #include "neighbour/cell_linked_list.hpp"
@@ -33,7 +34,8 @@ class FluidModule final : public Module {
         kernel_(build_kernel(spec_.body(), D)),
         domain_(build_domain<D>(*context.scene)),
         fluid_(spec_.body().name().empty() ? spec.name() : spec_.body().name()),
-        walls_(name_ + "_walls") {
+        walls_(name_ + "_walls"),
+        contact_(name_ + "_contact") {
     if (spec_.has_sound_speed())
       sound_speed_ = spec_.sound_speed();
     else if (spec_.has_max_velocity())
@@ -76,6 +78,11 @@ class FluidModule final : public Module {
     ModuleInfo info;
     info.type = "fluid";
     info.name = name_;
+    // A coupler fills `contact` with another body's particles (position, velocity, volume and,
+    // optionally, acceleration: e.g. a solid's `interface`) and reads back the fluid's force on
+    // each of them from `contact_force` (e.g. into the solid's `external_force`).
+    info.reads = {{"contact", {"position", "velocity", "volume", "acceleration"}}};
+    info.writes = {{"contact_force", {"force"}}};
     auto& f = info.active_features;
     f.push_back("weakly-compressible SPH, kernel " + kernel_name(kernel_.type()));
     f.push_back(spec_.riemann_solver() == "acoustic" ? "acoustic Riemann solver"
@@ -165,7 +172,7 @@ class FluidModule final : public Module {
   double time() const override { return time_; }
 
   void prepare_output() override {
-    if (walls_.has("force")) compute_wall_force();
+    if (walls_.particles.has("force")) compute_boundary_force(walls_);
     if (!fluid_.has("vorticity")) return;
     if constexpr (D == 2) {
       const auto& x = fluid_.vector("position");
@@ -187,11 +194,66 @@ class FluidModule final : public Module {
     }
   }
 
-  void write(const std::string& port, FieldBuffer&) const override {
-    throw RuntimeError("module '" + name_ + "' has no port '" + port + "' yet");
+  // The force of the fluid on each contact particle, from the current state.
+  void write(const std::string& port, FieldBuffer& out) const override {
+    if (port != "contact_force")
+      throw RuntimeError("module '" + name_ + "' writes only the port 'contact_force'");
+    std::vector<Vec<D>> force(contact_.particles.size(), Vec<D>::Zero());
+    if (!contact_.empty()) boundary_force(contact_, force);
+    out.points = force.size();
+    out.arrays.clear();
+    auto& f = out.arrays["force"];
+    f.components = D;
+    for (const auto& v : force) f.values.insert(f.values.end(), v.data(), v.data() + D);
   }
-  void read(const std::string& port, const FieldBuffer&) override {
-    throw RuntimeError("module '" + name_ + "' has no port '" + port + "' yet");
+
+  // Another body's particles as seen by the fluid until the next exchange.
+  void read(const std::string& port, const FieldBuffer& in) override {
+    if (port != "contact")
+      throw RuntimeError("module '" + name_ + "' has no port '" + port + "' (it reads 'contact')");
+    const std::size_t n = in.points;
+    auto field = [&](const std::string& name, int components, bool required) {
+      auto it = in.arrays.find(name);
+      if (it == in.arrays.end()) {
+        if (required)
+          throw RuntimeError("module '" + name_ + "': port 'contact' needs '" + name + "'");
+        return static_cast<const std::vector<double>*>(nullptr);
+      }
+      if (it->second.components != components || it->second.values.size() != n * components)
+        throw RuntimeError("module '" + name_ + "': port 'contact': '" + name + "' needs " +
+                           std::to_string(components) + " component(s) for each of " +
+                           std::to_string(n) + " points");
+      return &it->second.values;
+    };
+    const auto* position = field("position", D, true);
+    const auto* velocity = field("velocity", D, true);
+    const auto* volume = field("volume", 1, true);
+    const auto* acceleration = field("acceleration", D, false);
+    auto& c = contact_.particles;
+    if (!c.has("position")) {
+      c.add_vector("position", {.output = true});
+      c.add_vector("velocity", {.output = true});
+      c.add_scalar("volume", {.output = true});
+      c.add_vector("acceleration");
+    }
+    c.resize(n);
+    auto& x = c.vector("position");
+    auto& v = c.vector("velocity");
+    auto& a = c.vector("acceleration");
+    auto& V = c.scalar("volume");
+    for (std::size_t i = 0; i < n; ++i) {
+      V[i] = (*volume)[i];
+      if (!(V[i] > 0.0))
+        throw RuntimeError("module '" + name_ + "': port 'contact': volume of point " +
+                           std::to_string(i) + " is not positive");
+      for (int d = 0; d < D; ++d) {
+        x[i][d] = (*position)[i * D + d];
+        v[i][d] = (*velocity)[i * D + d];
+        a[i][d] = acceleration ? (*acceleration)[i * D + d] : 0.0;
+      }
+    }
+    contact_.moves = true;  // its cell list is rebuilt at every advection step
+    contact_.cells.reset();
   }
 
   void save(StateRecord& state) const override {
@@ -225,16 +287,16 @@ class FluidModule final : public Module {
 
   void bodies(BodyViews& views) const override {
     BodyView<D> fluid{name_, &fluid_, kernel_, domain_};
-    BodyView<D> walls{name_, &walls_, kernel_, domain_};
+    BodyView<D> walls{name_, &walls_.particles, kernel_, domain_};
     if constexpr (D == 2) {
       views.bodies2.push_back(fluid);
-      if (walls_.size() > 0) views.bodies2.push_back(walls);
+      if (!walls_.empty()) views.bodies2.push_back(walls);
     } else {
       views.bodies3.push_back(fluid);
-      if (walls_.size() > 0) views.bodies3.push_back(walls);
+      if (!walls_.empty()) views.bodies3.push_back(walls);
     }
   }
-  std::size_t particle_count() const override { return fluid_.size() + walls_.size(); }
+  std::size_t particle_count() const override { return fluid_.size() + walls_.particles.size(); }
 
   // Weak compressibility: the density stays within 30% of rho0 (a healthy run stays within a
   // few percent; beyond this the sound speed is too low for the flow).
@@ -330,19 +392,20 @@ class FluidModule final : public Module {
         owner.push_back(k);
       }
     }
-    walls_.resize(x.size());
-    walls_.add_vector("position", {.output = true}) = x;
-    walls_.add_scalar("volume", {.output = true}) = volume;
-    walls_.add_vector("velocity", {.output = true});
-    if (has_output("wall_force")) walls_.add_vector("force", {.output = true});
+    auto& walls = walls_.particles;
+    walls.resize(x.size());
+    walls.add_vector("position", {.output = true}) = x;
+    walls.add_scalar("volume", {.output = true}) = volume;
+    walls.add_vector("velocity", {.output = true});
+    if (has_output("wall_force")) walls.add_vector("force", {.output = true});
     wall_owner_ = owner;
-    for (const auto& w : wall_velocity_) walls_move_ = walls_move_ || !w.empty();
+    for (const auto& w : wall_velocity_) walls_.moves = walls_.moves || !w.empty();
     update_wall_velocity(0.0);
   }
 
   void update_wall_velocity(double t) {
-    if (walls_.size() == 0) return;
-    auto& v = walls_.vector("velocity");
+    if (walls_.empty()) return;
+    auto& v = walls_.particles.vector("velocity");
     for (std::size_t i = 0; i < v.size(); ++i) {
       const auto& expressions = wall_velocity_[wall_owner_[i]];
       for (int a = 0; a < D; ++a)
@@ -353,10 +416,10 @@ class FluidModule final : public Module {
   // Moving walls move with their prescribed velocity over the acoustic sub-step [t, t + dt],
   // taken at its middle.
   void move_walls(double t, double dt) {
-    if (!walls_move_) return;
+    if (!walls_.moves) return;
     update_wall_velocity(t + 0.5 * dt);
-    auto& x = walls_.vector("position");
-    const auto& v = walls_.vector("velocity");
+    auto& x = walls_.particles.vector("position");
+    const auto& v = walls_.particles.vector("velocity");
     for (std::size_t i = 0; i < x.size(); ++i) x[i] += dt * v[i];
   }
 
@@ -389,22 +452,26 @@ class FluidModule final : public Module {
     const auto& x = fluid_.vector("position");
     inner_ = build_inner_list<D>(x, kernel_.support_radius(), domain_);
     pair_geometry(x, x, inner_, inner_geometry_);
-    if (walls_.size() > 0) {
-      const auto& wx = walls_.vector("position");
-      // Static walls keep their cell list; moving walls rebuild it every step.
-      if (!wall_cells_ || walls_move_) wall_cells_.emplace(wx, kernel_.support_radius(), domain_);
-      contact_ = build_contact_list<D>(x, *wall_cells_, kernel_.support_radius());
-      pair_geometry(x, wx, contact_, contact_geometry_);
+    for (BoundarySet<D>* b : {&walls_, &contact_}) {
+      if (b->empty()) continue;
+      const auto& bx = b->particles.vector("position");
+      // Static walls keep their cell list; moving walls and contact bodies rebuild it.
+      if (!b->cells || b->moves) b->cells.emplace(bx, kernel_.support_radius(), domain_);
+      b->list = build_contact_list<D>(x, *b->cells, kernel_.support_radius());
+      pair_geometry(x, bx, b->list, b->geometry);
     }
   }
 
-  struct PairGeometry {
-    std::vector<Vec<D>> direction;  // e_ij = (x_j - x_i) / r_ij
-    std::vector<double> gradient;   // -dW/dr (r_ij) >= 0
-  };
+  // The boundary sets that have particles, walls first.
+  std::vector<const BoundarySet<D>*> boundaries() const {
+    std::vector<const BoundarySet<D>*> sets;
+    for (const BoundarySet<D>* b : {&walls_, &contact_})
+      if (!b->empty()) sets.push_back(b);
+    return sets;
+  }
 
   void pair_geometry(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,
-                     const NeighbourList& list, PairGeometry& g) const {
+                     const NeighbourList& list, PairGeometry<D>& g) const {
     g.direction.resize(list.pair_count());
     g.gradient.resize(list.pair_count());
     parallel_for_each_index(a.size(), [&](std::size_t i) {
@@ -425,15 +492,17 @@ class FluidModule final : public Module {
     auto& rho = fluid_.scalar("density");
     const double rho0 = spec_.density(), sigma0 = reference_number_density_;
     const bool free_surface = spec_.density_treatment() == "reinitialisation";
-    const std::vector<Vec<D>>* wx = walls_.size() > 0 ? &walls_.vector("position") : nullptr;
-    const std::vector<double>* wv = walls_.size() > 0 ? &walls_.scalar("volume") : nullptr;
+    const auto sets = boundaries();
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       double sigma = m[i] / rho0 * kernel_.value(0.0);
       for (Index j : inner_.of(i))
         sigma += m[j] / rho0 * kernel_.value(domain_.displacement(x[i], x[j]).norm());
-      if (wx)
-        for (Index w : contact_.of(i))
-          sigma += (*wv)[w] * kernel_.value(domain_.displacement(x[i], (*wx)[w]).norm());
+      for (const BoundarySet<D>* b : sets) {
+        const auto& bx = b->particles.vector("position");
+        const auto& bV = b->particles.scalar("volume");
+        for (Index w : b->list.of(i))
+          sigma += bV[w] * kernel_.value(domain_.displacement(x[i], bx[w]).norm());
+      }
       const double summed = rho0 * sigma / sigma0;
       rho[i] = free_surface || near_open_boundary(i) ? std::max(rho[i], summed) : summed;
     });
@@ -463,10 +532,7 @@ class FluidModule final : public Module {
     const auto& m = fluid_.scalar("mass");
     auto& a = fluid_.vector("acceleration");
     const double eta = spec_.viscosity();
-    const bool walls = walls_.size() > 0;
-    const auto& wx = walls_.vector("position");
-    const auto& wv = walls_.vector("velocity");
-    const auto& wV = walls_.scalar("volume");
+    const auto sets = boundaries();
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
       if (eta > 0.0) {
@@ -475,11 +541,14 @@ class FluidModule final : public Module {
           if (r <= 0.0) continue;
           sum += (m[j] / rho[j] * kernel_.derivative(r) / r) * (v[i] - v[j]);
         }
-        if (walls) {
-          for (Index w : contact_.of(i)) {
-            const double r = domain_.displacement(x[i], wx[w]).norm();
+        for (const BoundarySet<D>* b : sets) {
+          const auto& bx = b->particles.vector("position");
+          const auto& bv = b->particles.vector("velocity");
+          const auto& bV = b->particles.scalar("volume");
+          for (Index w : b->list.of(i)) {
+            const double r = domain_.displacement(x[i], bx[w]).norm();
             if (r <= 0.0) continue;
-            sum += (wV[w] * kernel_.derivative(r) / r) * (2.0 * (v[i] - wv[w]));
+            sum += (bV[w] * kernel_.derivative(r) / r) * (2.0 * (v[i] - bv[w]));
           }
         }
         sum *= 2.0 * eta / rho[i];
@@ -499,9 +568,7 @@ class FluidModule final : public Module {
     const auto& volume = fluid_.scalar("volume");
     const double h = kernel_.smoothing_length();
     shift_.resize(x.size());
-    const bool walls = walls_.size() > 0;
-    const auto& wx = walls_.vector("position");
-    const auto& wV = walls_.scalar("volume");
+    const auto sets = boundaries();
     for (int sweep = 0; sweep < spec_.transport_velocity_sweeps(); ++sweep) {
       parallel_for_each_index(x.size(), [&](std::size_t i) {
         Vec<D> sum = Vec<D>::Zero();
@@ -510,11 +577,13 @@ class FluidModule final : public Module {
           const double r = d.norm();
           if (r > 0.0) sum += volume[j] * kernel_.derivative(r) / r * d;
         }
-        if (walls) {
-          for (Index w : contact_.of(i)) {
-            const Vec<D> d = domain_.displacement(x[i], wx[w]);
+        for (const BoundarySet<D>* b : sets) {
+          const auto& bx = b->particles.vector("position");
+          const auto& bV = b->particles.scalar("volume");
+          for (Index w : b->list.of(i)) {
+            const Vec<D> d = domain_.displacement(x[i], bx[w]);
             const double r = d.norm();
-            if (r > 0.0) sum += wV[w] * kernel_.derivative(r) / r * d;
+            if (r > 0.0) sum += bV[w] * kernel_.derivative(r) / r * d;
           }
         }
         shift_[i] = near_open_boundary(i) ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
@@ -589,14 +658,32 @@ class FluidModule final : public Module {
     impose_inflow(time_ + 0.0);
   }
 
-  // The force of the fluid on each wall particle, the reaction to the wall terms of the fluid's
-  // momentum equation: pressure 2 V_i V_w P* |dW| e_iw and viscosity 4 eta V_i V_w |dW|/r
-  // (v_i - v_w), gathered over the fluid neighbours of each wall particle.
-  void compute_wall_force() {
-    auto& force = walls_.vector("force");
-    const auto& wx = walls_.vector("position");
-    const auto& wv = walls_.vector("velocity");
-    const auto& wV = walls_.scalar("volume");
+  // The arrays of a boundary set that the pair loops read, and the state it presents to a fluid
+  // particle (walls have no acceleration field: theirs is taken as zero).
+  struct BoundaryView {
+    const std::vector<Vec<D>>& x;
+    const std::vector<Vec<D>>& v;
+    const std::vector<double>& V;
+    const std::vector<Vec<D>>* a;
+    Vec<D> g;
+    BoundaryView(const BoundarySet<D>& b, const Vec<D>& gravity)
+        : x(b.particles.vector("position")),
+          v(b.particles.vector("velocity")),
+          V(b.particles.scalar("volume")),
+          a(b.particles.has("acceleration") ? &b.particles.vector("acceleration") : nullptr),
+          g(gravity) {}
+    OneSidedState<D> state(Index w, double p_i, double rho_i, const Vec<D>& v_i,
+                           const Vec<D>& x_w_minus_x_i) const {
+      return one_sided_state<D>(p_i, rho_i, v_i, v[w], a ? Vec<D>(g - (*a)[w]) : g, x_w_minus_x_i);
+    }
+  };
+
+  // The force of the fluid on each particle of a boundary set, the reaction to the boundary
+  // terms of the fluid's momentum equation: pressure 2 V_i V_w P* |dW| e_iw and viscosity
+  // 4 eta V_i V_w |dW|/r (v_i - v_w), gathered over the fluid neighbours of each boundary
+  // particle (no atomics; the same sum for any thread count).
+  void boundary_force(const BoundarySet<D>& b, std::vector<Vec<D>>& force) const {
+    const BoundaryView view(b, gravity_);
     const auto& x = fluid_.vector("position");
     const auto& v = fluid_.vector("velocity");
     const auto& rho = fluid_.scalar("density");
@@ -605,22 +692,28 @@ class FluidModule final : public Module {
     const double eta = spec_.viscosity(), support = kernel_.support_radius();
     const CellLinkedList<D> cells(x, support, domain_);
     const RiemannSolver solver = riemann();
-    parallel_for_each_index(wx.size(), [&](std::size_t w) {
+    force.assign(view.x.size(), Vec<D>::Zero());
+    parallel_for_each_index(view.x.size(), [&](std::size_t w) {
       Vec<D> sum = Vec<D>::Zero();
-      cells.for_each_neighbour(wx[w], support, Index(-1), [&](Index i) {
-        const Vec<D> d = domain_.displacement(wx[w], x[i]);  // from fluid i to wall w
+      cells.for_each_neighbour(view.x[w], support, Index(-1), [&](Index i) {
+        const Vec<D> d = domain_.displacement(view.x[w], x[i]);  // from fluid i to boundary w
         const double r = d.norm();
         if (r <= 0.0 || r >= support) return;
         const Vec<D> e = d / r;
         const double g = -kernel_.derivative(r);
-        const Vec<D> mirrored = 2.0 * wv[w] - v[i];
-        const double p_wall = p[i] + rho[i] * gravity_.dot(d);
-        const double P = solver.pressure(p[i], p_wall, v[i].dot(e), mirrored.dot(e));
-        sum += (2.0 * volume[i] * wV[w] * P * g) * e;
-        if (eta > 0.0) sum += (4.0 * eta * volume[i] * wV[w] * g / r) * (v[i] - wv[w]);
+        const auto wall = view.state(Index(w), p[i], rho[i], v[i], d);
+        const double P = solver.pressure(p[i], wall.pressure, v[i].dot(e), wall.velocity.dot(e));
+        sum += (2.0 * volume[i] * view.V[w] * P * g) * e;
+        if (eta > 0.0) sum += (4.0 * eta * volume[i] * view.V[w] * g / r) * (v[i] - view.v[w]);
       });
       force[w] = sum;
     });
+  }
+
+  void compute_boundary_force(BoundarySet<D>& b) {
+    std::vector<Vec<D>> force;
+    boundary_force(b, force);
+    b.particles.vector("force") = std::move(force);
   }
 
   Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
@@ -643,10 +736,7 @@ class FluidModule final : public Module {
       x[i] = wrap(x[i] + 0.5 * dt * v[i]);
     });
     const RiemannSolver solver = riemann();
-    const bool walls = walls_.size() > 0;
-    const auto& wx = walls_.vector("position");
-    const auto& wv = walls_.vector("velocity");
-    const auto& wV = walls_.scalar("volume");
+    const auto sets = boundaries();
     dv_.resize(x.size());
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
@@ -656,16 +746,15 @@ class FluidModule final : public Module {
         const double P = solver.pressure(p[i], p[j], v[i].dot(e), v[j].dot(e));
         sum -= (volume[j] * P * inner_geometry_.gradient[k]) * e;
       }
-      if (walls) {
-        for (std::size_t k = contact_.offset[i]; k < contact_.offset[i + 1]; ++k) {
-          const Index w = contact_.index[k];
-          const Vec<D>& e = contact_geometry_.direction[k];
-          // One-sided Riemann problem (seed 003 eqs. 14-16): the wall mirrors the particle's
-          // velocity about its own and extends its pressure hydrostatically.
-          const Vec<D> mirrored = 2.0 * wv[w] - v[i];
-          const double p_wall = p[i] + rho[i] * gravity_.dot(domain_.displacement(wx[w], x[i]));
-          const double P = solver.pressure(p[i], p_wall, v[i].dot(e), mirrored.dot(e));
-          sum -= (wV[w] * P * contact_geometry_.gradient[k]) * e;
+      for (const BoundarySet<D>* b : sets) {
+        const BoundaryView view(*b, gravity_);
+        for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
+          const Index w = b->list.index[k];
+          const Vec<D>& e = b->geometry.direction[k];
+          const auto wall =
+              view.state(w, p[i], rho[i], v[i], domain_.displacement(view.x[w], x[i]));
+          const double P = solver.pressure(p[i], wall.pressure, v[i].dot(e), wall.velocity.dot(e));
+          sum -= (view.V[w] * P * b->geometry.gradient[k]) * e;
         }
       }
       dv_[i] = (2.0 / rho[i]) * sum;
@@ -685,10 +774,7 @@ class FluidModule final : public Module {
     parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + 0.5 * dt * v[i]); });
     move_walls(t, dt);
     const RiemannSolver solver = riemann();
-    const bool walls = walls_.size() > 0;
-    const auto& wx = walls_.vector("position");
-    const auto& wv = walls_.vector("velocity");
-    const auto& wV = walls_.scalar("volume");
+    const auto sets = boundaries();
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       double sum = 0.0;
       for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
@@ -698,15 +784,16 @@ class FluidModule final : public Module {
         const double U = solver.velocity(p[i], p[j], u, v[j].dot(e));
         sum += volume[j] * (u - U) * inner_geometry_.gradient[k];
       }
-      if (walls) {
-        for (std::size_t k = contact_.offset[i]; k < contact_.offset[i + 1]; ++k) {
-          const Index w = contact_.index[k];
-          const Vec<D>& e = contact_geometry_.direction[k];
-          const Vec<D> mirrored = 2.0 * wv[w] - v[i];
-          const double p_wall = p[i] + rho[i] * gravity_.dot(domain_.displacement(wx[w], x[i]));
+      for (const BoundarySet<D>* b : sets) {
+        const BoundaryView view(*b, gravity_);
+        for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
+          const Index w = b->list.index[k];
+          const Vec<D>& e = b->geometry.direction[k];
+          const auto wall =
+              view.state(w, p[i], rho[i], v[i], domain_.displacement(view.x[w], x[i]));
           const double u = v[i].dot(e);
-          const double U = solver.velocity(p[i], p_wall, u, mirrored.dot(e));
-          sum += wV[w] * (u - U) * contact_geometry_.gradient[k];
+          const double U = solver.velocity(p[i], wall.pressure, u, wall.velocity.dot(e));
+          sum += view.V[w] * (u - U) * b->geometry.gradient[k];
         }
       }
       drho[i] = 2.0 * rho[i] * sum;
@@ -720,7 +807,8 @@ class FluidModule final : public Module {
   proto::FluidSpec spec_;
   Kernel kernel_;
   Domain<D> domain_;
-  ParticleSet<D> fluid_, walls_;
+  ParticleSet<D> fluid_;
+  BoundarySet<D> walls_, contact_;
   std::vector<int> wall_owner_;
   std::vector<std::vector<Expression>> wall_velocity_;
   std::vector<Expression> initial_velocity_, inflow_velocity_;
@@ -728,10 +816,8 @@ class FluidModule final : public Module {
   Expression initial_pressure_;
   Vec<D> gravity_ = Vec<D>::Zero();
   double sound_speed_ = 0.0, reference_number_density_ = 1.0;
-  NeighbourList inner_, contact_;
-  std::optional<CellLinkedList<D>> wall_cells_;
-  bool walls_move_ = false;
-  PairGeometry inner_geometry_, contact_geometry_;
+  NeighbourList inner_;
+  PairGeometry<D> inner_geometry_;
   std::vector<Vec<D>> dv_, shift_;
   double time_ = 0.0;
   long long steps_ = 0, acoustic_steps_ = 0;
