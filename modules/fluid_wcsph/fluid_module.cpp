@@ -10,6 +10,7 @@
 #include "driver/scene_geometry.hpp"
 #include "expression/expression.hpp"
 #include "fluid_wcsph/boundary_set.hpp"
+#include "fluid_wcsph/open_boundaries.hpp"
 #include "fluid_wcsph/riemann.hpp"
 #include "geometry/lattice.hpp"
 #include "neighbour/cell_linked_list.hpp"
@@ -35,7 +36,8 @@ class FluidModule final : public Module {
         domain_(build_domain<D>(*context.scene)),
         fluid_(spec_.body().name().empty() ? spec.name() : spec_.body().name()),
         walls_(name_ + "_walls"),
-        contact_(name_ + "_contact") {
+        contact_(name_ + "_contact"),
+        open_(spec_, kernel_.support_radius(), key_) {
     if (spec_.has_sound_speed())
       sound_speed_ = spec_.sound_speed();
     else if (spec_.has_max_velocity())
@@ -47,23 +49,6 @@ class FluidModule final : public Module {
       initial_velocity_.push_back(
           parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));
     initial_pressure_ = parse(spec_.initial_pressure(), key_ + ".initial_pressure");
-    if (spec_.has_inflow()) {
-      const auto& in = spec_.inflow();
-      const std::string path = key_ + ".inflow";
-      if (in.axis() >= D) throw ConfigError(path + ".axis", "axis must be below the dimension");
-      for (int a = 0; a < in.velocity_size(); ++a)
-        inflow_velocity_.push_back(
-            parse_field(in.velocity(a), path + ".velocity[" + std::to_string(a) + "]"));
-      buffer_lower_ = to_vec<D>(in.buffer().lower());
-      buffer_upper_ = to_vec<D>(in.buffer().upper());
-      const double length = buffer_upper_[in.axis()] - buffer_lower_[in.axis()];
-      if (!(length >= kernel_.support_radius()))
-        throw ConfigError(path + ".buffer", "the buffer must be at least one kernel support (" +
-                                                std::to_string(kernel_.support_radius()) +
-                                                ") long along the axis");
-    }
-    if (spec_.has_outflow() && spec_.outflow().axis() >= D)
-      throw ConfigError(key_ + ".outflow.axis", "axis must be below the dimension");
     for (int k = 0; k < spec_.walls_size(); ++k) {
       std::vector<Expression> velocity;
       for (int a = 0; a < spec_.walls(k).velocity_size(); ++a)
@@ -95,8 +80,7 @@ class FluidModule final : public Module {
       f.push_back("transport velocity (" + std::to_string(spec_.transport_velocity_sweeps()) +
                   " sweeps)");
     if (spec_.walls_size() > 0) f.push_back("walls (one-sided Riemann)");
-    if (spec_.has_inflow()) f.push_back("inflow buffer");
-    if (spec_.has_outflow()) f.push_back("outflow");
+    for (const auto& o : open_.features()) f.push_back(o);
     if (domain_.any_periodic()) f.push_back("periodic");
     for (const auto& o : spec_.outputs()) f.push_back("output " + o);
     return info;
@@ -116,7 +100,6 @@ class FluidModule final : public Module {
     fluid_.add_scalar("density_rate", {.checkpoint = true});
     fluid_.add_vector("acceleration");
     if (has_output("vorticity")) fluid_.add_scalar("vorticity", {.output = true});
-    if (spec_.has_inflow()) fluid_.add_scalar("in_buffer", {.checkpoint = true});
     const double rho0 = spec_.density(), c2 = sound_speed_ * sound_speed_;
     for (std::size_t i = 0; i < n; ++i) {
       x[i] = domain_.any_periodic() ? domain_.wrap(cloud.positions[i]) : cloud.positions[i];
@@ -128,11 +111,7 @@ class FluidModule final : public Module {
       for (int a = 0; a < D && !initial_velocity_.empty(); ++a)
         v[i][a] = initial_velocity_[a].evaluate(point);
     }
-    if (spec_.has_inflow()) {
-      auto& buffer = fluid_.scalar("in_buffer");
-      for (std::size_t i = 0; i < n; ++i) buffer[i] = inside_buffer(x[i]) ? 1.0 : 0.0;
-      impose_inflow(0.0);
-    }
+    open_.initialize(fluid_, 0.0);
     sort_by_cell();
     build_walls();
     reference_number_density_ = lattice_number_density();
@@ -163,7 +142,7 @@ class FluidModule final : public Module {
       done += dt;
       ++acoustic_steps_;
     }
-    if (spec_.has_inflow() || spec_.has_outflow()) update_open_boundaries();
+    if (open_.any()) open_.update(fluid_, time_ + Dt);
     update_volumes();
     time_ += Dt;
     ++steps_;
@@ -320,16 +299,9 @@ class FluidModule final : public Module {
       throw ConfigError(key, e.what());
     }
   }
-  static Expression parse_field(const std::string& text, const std::string& key) {
-    try {
-      return Expression::parse(text, {"x", "y", "z", "t"});
-    } catch (const ExpressionError& e) {
-      throw ConfigError(key, e.what());
-    }
-  }
   std::vector<std::string> checkpointed() const {
     std::vector<std::string> f{"position", "velocity", "density", "density_rate", "mass"};
-    if (spec_.has_inflow()) f.push_back("in_buffer");
+    if (open_.has_inflow()) f.push_back("in_buffer");
     return f;
   }
   static Expression parse_time(const std::string& text, const std::string& key) {
@@ -493,6 +465,7 @@ class FluidModule final : public Module {
     const double rho0 = spec_.density(), sigma0 = reference_number_density_;
     const bool free_surface = spec_.density_treatment() == "reinitialisation";
     const auto sets = boundaries();
+    const auto truncated = open_.truncation(fluid_);
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       double sigma = m[i] / rho0 * kernel_.value(0.0);
       for (Index j : inner_.of(i))
@@ -504,7 +477,7 @@ class FluidModule final : public Module {
           sigma += bV[w] * kernel_.value(domain_.displacement(x[i], bx[w]).norm());
       }
       const double summed = rho0 * sigma / sigma0;
-      rho[i] = free_surface || near_open_boundary(i) ? std::max(rho[i], summed) : summed;
+      rho[i] = free_surface || truncated(i) ? std::max(rho[i], summed) : summed;
     });
     update_pressure();
   }
@@ -569,6 +542,7 @@ class FluidModule final : public Module {
     const double h = kernel_.smoothing_length();
     shift_.resize(x.size());
     const auto sets = boundaries();
+    const auto truncated = open_.truncation(fluid_);
     for (int sweep = 0; sweep < spec_.transport_velocity_sweeps(); ++sweep) {
       parallel_for_each_index(x.size(), [&](std::size_t i) {
         Vec<D> sum = Vec<D>::Zero();
@@ -586,76 +560,10 @@ class FluidModule final : public Module {
             if (r > 0.0) sum += bV[w] * kernel_.derivative(r) / r * d;
           }
         }
-        shift_[i] = near_open_boundary(i) ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
+        shift_[i] = truncated(i) ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
       });
       parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift_[i]); });
     }
-  }
-
-  bool inside_buffer(const Vec<D>& x) const {
-    for (int a = 0; a < D; ++a)
-      if (x[a] < buffer_lower_[a] || x[a] > buffer_upper_[a]) return false;
-    return true;
-  }
-
-  // Inflow-buffer particles, and particles within one kernel support of the outflow plane, have
-  // truncated neighbourhoods: their summed density would be too low (a spurious suction), so they
-  // keep the larger of the summed and the continuity density, and the transport-velocity shift,
-  // which would push them out of the fluid, leaves them alone.
-  bool near_open_boundary(std::size_t i) const {
-    if (spec_.has_inflow() && fluid_.scalar("in_buffer")[i] > 0.0) return true;
-    if (spec_.has_outflow()) {
-      const auto& out = spec_.outflow();
-      if (fluid_.vector("position")[i][out.axis()] > out.position() - kernel_.support_radius())
-        return true;
-    }
-    return false;
-  }
-
-  void impose_inflow(double t) {
-    const auto& x = fluid_.vector("position");
-    auto& v = fluid_.vector("velocity");
-    const auto& buffer = fluid_.scalar("in_buffer");
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      if (buffer[i] == 0.0) continue;
-      const auto p = space(x[i]);
-      for (int a = 0; a < D; ++a) v[i][a] = inflow_velocity_[a].evaluate({p[0], p[1], p[2], t});
-    }
-  }
-
-  // Once per advection step: particles past the outflow plane leave; a buffer particle that has
-  // left its box downstream becomes free and a copy of it re-enters one buffer length upstream.
-  // The survivors keep their order and the new particles go to the end, so the result does not
-  // depend on the thread count.
-  void update_open_boundaries() {
-    const std::size_t n = fluid_.size();
-    const auto& x = fluid_.vector("position");
-    std::vector<Index> keep, spawn;
-    keep.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (spec_.has_outflow() && x[i][spec_.outflow().axis()] > spec_.outflow().position())
-        continue;
-      keep.push_back(Index(i));
-      if (spec_.has_inflow() && fluid_.scalar("in_buffer")[i] > 0.0 &&
-          x[i][spec_.inflow().axis()] > buffer_upper_[spec_.inflow().axis()])
-        spawn.push_back(Index(i));
-    }
-    if (keep.size() == n && spawn.empty()) return;
-    const std::size_t survivors = keep.size();
-    keep.insert(keep.end(), spawn.begin(), spawn.end());
-    fluid_.select(keep);
-    if (spawn.empty()) return;
-    const int axis = spec_.inflow().axis();
-    const double length = buffer_upper_[axis] - buffer_lower_[axis];
-    auto& position = fluid_.vector("position");
-    auto& buffer = fluid_.scalar("in_buffer");
-    for (std::size_t i = 0; i < survivors; ++i)
-      if (buffer[i] > 0.0 && position[i][axis] > buffer_upper_[axis]) buffer[i] = 0.0;
-    for (std::size_t i = survivors; i < position.size(); ++i) {
-      position[i][axis] -= length;
-      buffer[i] = 1.0;
-    }
-    impose_inflow(time_ + 0.0);
   }
 
   // The arrays of a boundary set that the pair loops read, and the state it presents to a fluid
@@ -677,6 +585,12 @@ class FluidModule final : public Module {
       return one_sided_state<D>(p_i, rho_i, v_i, v[w], a ? Vec<D>(g - (*a)[w]) : g, x_w_minus_x_i);
     }
   };
+
+  std::vector<BoundaryView> boundary_views(const std::vector<const BoundarySet<D>*>& sets) const {
+    std::vector<BoundaryView> views;
+    for (const BoundarySet<D>* b : sets) views.emplace_back(*b, gravity_);
+    return views;
+  }
 
   // The force of the fluid on each particle of a boundary set, the reaction to the boundary
   // terms of the fluid's momentum equation: pressure 2 V_i V_w P* |dW| e_iw and viscosity
@@ -737,6 +651,7 @@ class FluidModule final : public Module {
     });
     const RiemannSolver solver = riemann();
     const auto sets = boundaries();
+    const auto views = boundary_views(sets);
     dv_.resize(x.size());
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
@@ -746,8 +661,9 @@ class FluidModule final : public Module {
         const double P = solver.pressure(p[i], p[j], v[i].dot(e), v[j].dot(e));
         sum -= (volume[j] * P * inner_geometry_.gradient[k]) * e;
       }
-      for (const BoundarySet<D>* b : sets) {
-        const BoundaryView view(*b, gravity_);
+      for (std::size_t s = 0; s < sets.size(); ++s) {
+        const BoundarySet<D>* b = sets[s];
+        const BoundaryView& view = views[s];
         for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
           const Index w = b->list.index[k];
           const Vec<D>& e = b->geometry.direction[k];
@@ -760,7 +676,7 @@ class FluidModule final : public Module {
       dv_[i] = (2.0 / rho[i]) * sum;
     });
     parallel_for_each_index(x.size(), [&](std::size_t i) { v[i] += dt * (dv_[i] + prior[i]); });
-    if (spec_.has_inflow()) impose_inflow(t + dt);
+    open_.impose(fluid_, t + dt);
   }
 
   // Second half: position to the end of the step, density rate from U*, density half step.
@@ -775,6 +691,7 @@ class FluidModule final : public Module {
     move_walls(t, dt);
     const RiemannSolver solver = riemann();
     const auto sets = boundaries();
+    const auto views = boundary_views(sets);
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       double sum = 0.0;
       for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
@@ -784,8 +701,9 @@ class FluidModule final : public Module {
         const double U = solver.velocity(p[i], p[j], u, v[j].dot(e));
         sum += volume[j] * (u - U) * inner_geometry_.gradient[k];
       }
-      for (const BoundarySet<D>* b : sets) {
-        const BoundaryView view(*b, gravity_);
+      for (std::size_t s = 0; s < sets.size(); ++s) {
+        const BoundarySet<D>* b = sets[s];
+        const BoundaryView& view = views[s];
         for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
           const Index w = b->list.index[k];
           const Vec<D>& e = b->geometry.direction[k];
@@ -809,10 +727,10 @@ class FluidModule final : public Module {
   Domain<D> domain_;
   ParticleSet<D> fluid_;
   BoundarySet<D> walls_, contact_;
+  OpenBoundaries<D> open_;
   std::vector<int> wall_owner_;
   std::vector<std::vector<Expression>> wall_velocity_;
-  std::vector<Expression> initial_velocity_, inflow_velocity_;
-  Vec<D> buffer_lower_ = Vec<D>::Zero(), buffer_upper_ = Vec<D>::Zero();
+  std::vector<Expression> initial_velocity_;
   Expression initial_pressure_;
   Vec<D> gravity_ = Vec<D>::Zero();
   double sound_speed_ = 0.0, reference_number_density_ = 1.0;
