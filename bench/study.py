@@ -17,6 +17,8 @@ import itertools
 import json
 import math
 import os
+import platform
+import re
 import shutil
 import subprocess
 import sys
@@ -371,6 +373,9 @@ def _parse_series_options(node: dict, kind: str) -> tuple:
         if not smooth > 0:
             raise StudyError("quantity.smooth: expected a positive time")
     scale = node.get("scale", 1.0)
+    if node.get("scale") is not None and (kind not in series_kinds and kind != "final"
+                                          or node.get("combine") is not None):
+        raise StudyError("quantity.scale: only used by a time series or a single final column")
     scale = _number(scale, "quantity.scale")
     if scale == 0:
         raise StudyError("quantity.scale: expected a nonzero factor")
@@ -639,21 +644,38 @@ def first_line(text: str) -> str:
     return ""
 
 
+def _referenced_files(scene: Path, overrides: dict) -> list:
+    """Files the scene (or an override) names by a relative or absolute path: point clouds,
+    fibre tables. Their bytes are part of a run's key."""
+    text = scene.read_text() + " " + " ".join(str(v) for v in overrides.values())
+    files = []
+    for token in set(re.findall(r"[\w./-]+\.(?:csv|stl|txt|dat)\b", text)):
+        path = (scene.parent / token) if not os.path.isabs(token) else Path(token)
+        if path.is_file():
+            files.append(path)
+    return sorted(files)
+
+
 def run_key(cosph: Path, scene: Path, overrides: dict, repeat: int) -> str:
-    """What a run's outputs depend on: the executable's bytes, the scene's text and the
-    overrides (and the number of repeats, whose fastest wall time is reported)."""
+    """What a run's outputs and timings depend on: the executable's bytes, the scene's text, the
+    files it names, the overrides, the number of repeats (the fastest wall time is reported) and
+    the machine (host name and CPU count), so that no timing comes from another machine."""
     digest = hashlib.sha256()
     with open(cosph, "rb") as stream:
         for block in iter(lambda: stream.read(1 << 20), b""):
             digest.update(block)
     digest.update(scene.read_bytes())
+    for path in _referenced_files(scene, overrides):
+        digest.update(str(path.name).encode())
+        digest.update(path.read_bytes())
+    digest.update(f"{platform.node()} {os.cpu_count()}".encode())
     digest.update(json.dumps([[k, format_value(v)] for k, v in overrides.items()]).encode())
     digest.update(str(repeat).encode())
     return digest.hexdigest()[:24]
 
 
 def run_point(study: Study, point: Point, cosph: Path, out_dir: Path, repeat: int,
-              timeout: float, cache: Optional[Path] = None) -> PointResult:
+              timeout: float, cache: Optional[Path] = None, refresh: bool = False) -> PointResult:
     """Runs one point (the fastest of `repeat` runs counts) and compares it with the reference.
     With a cache directory, a run with the same executable, scene and overrides (from this or
     another study) is reused instead of repeated."""
@@ -661,6 +683,8 @@ def run_point(study: Study, point: Point, cosph: Path, out_dir: Path, repeat: in
     best_summary = None
     if cache is not None:
         out_dir = cache / run_key(cosph, study.scene, point.overrides, repeat)
+        if refresh and out_dir.exists():
+            shutil.rmtree(out_dir)
         try:
             best_summary = json.loads((out_dir / "summary.json").read_text())
             result.message = "reused"
@@ -797,6 +821,7 @@ def _prepare_series(quantity: Quantity, times, series) -> tuple:
     if quantity.smooth is not None and len(times) > 2:
         dt = float(np.median(np.diff(times)))
         width = max(1, int(round(quantity.smooth / dt)))
+        width += 1 - width % 2  # odd, so that the average is centred on each sample
         if width > 1:
             kernel = np.ones(width) / width
             padded = np.pad(series, (width // 2, width - 1 - width // 2), mode="edge")
@@ -1192,7 +1217,8 @@ class StudyRun:
 
 
 def run_study(study: Study, cosph: Path, out_dir: Path, repeat: int, timeout: float,
-              log: Callable[[str], None] = print, cache: Optional[Path] = None) -> StudyRun:
+              log: Callable[[str], None] = print, cache: Optional[Path] = None,
+              refresh: bool = False) -> StudyRun:
     """Runs every point of a study and writes results.csv, table.md and plot.png (OSError when
     one cannot be written)."""
     start = time.monotonic()
@@ -1200,7 +1226,7 @@ def run_study(study: Study, cosph: Path, out_dir: Path, repeat: int, timeout: fl
     results = []
     for point in points:
         result = run_point(study, point, cosph, out_dir / "points" / str(point.index), repeat,
-                           timeout, cache)
+                           timeout, cache, refresh)
         results.append(result)
         log(f"[{point.index + 1}/{len(points)}] {point.label}: {result.status}"
             + (f" ({result.message})" if result.message else "")

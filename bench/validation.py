@@ -8,7 +8,9 @@ usage: /usr/bin/python3 bench/validation.py [--studies FILE ...] [--cosph PATH] 
 
 Runs are kept in bench/results/runs/ under a key of the executable's bytes, the scene and the
 overrides: studies that share a run (the cylinder's drag, lift and period) run it once, and a
-regeneration with an unchanged executable reuses every run (--fresh reruns them).
+regeneration with an unchanged executable reuses every run (--fresh reruns them and replaces
+the kept runs). The key includes the host name and CPU count: timings never come from another
+machine. A reused run is marked "reused" in the tables.
 
 Exit codes: 0 written (points may have failed: the tables say so), 1 a file could not be
 written, 2 an invalid study file or usage.
@@ -230,8 +232,9 @@ def parse_args(argv: Optional[list]) -> argparse.Namespace:
     parser.add_argument("--repeat", type=int,
                         help="runs per point (default: each study's 'repeat')")
     parser.add_argument("--fresh", action="store_true",
-                        help="rerun every point (default: reuse runs of the same executable, "
-                             "scene and overrides kept in bench/results/runs/)")
+                        help="rerun every point and replace its kept run (default: reuse "
+                             "runs of the same executable, scene, files, overrides and machine "
+                             "kept in bench/results/runs/)")
     parser.add_argument("--output", type=Path, default=DOCS_DIR / "VALIDATION.md",
                         help="document to write (default: %(default)s)")
     args = parser.parse_args(argv)
@@ -270,9 +273,10 @@ def main(argv: Optional[list] = None) -> int:
         for study in loaded:
             print(f"== {study.name} ({len(study.points())} points)")
             out_dir = REPO_ROOT / "bench" / "results" / study.name
-            cache = None if args.fresh else REPO_ROOT / "bench" / "results" / "runs"
             runs.append(studies.run_study(study, cosph, out_dir, args.repeat or study.repeat,
-                                          timeout=900.0, cache=cache))
+                                          timeout=900.0,
+                                          cache=REPO_ROOT / "bench" / "results" / "runs",
+                                          refresh=args.fresh))
         write_document(args.output.resolve(), runs, machine, time.monotonic() - start)
     except OSError as error:
         print(f"validation.py: error: cannot write: {error}", file=sys.stderr)

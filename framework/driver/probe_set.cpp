@@ -165,6 +165,11 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
       }
       if (spec.reduce().has_within() && q != "total")
         throw ConfigError(path + ".reduce.within", "only a 'total' takes a box");
+      if (spec.reduce().has_within())
+        for (int a = 0; a < D; ++a)
+          if (!(spec.reduce().within().lower(a) <= spec.reduce().within().upper(a)))
+            throw ConfigError(path + ".reduce.within",
+                              "the box needs lower <= upper along every axis");
       if ((q == "extent" || q == "front" || q == "surface_height") && spec.reduce().axis() >= D)
         throw ConfigError(path + ".reduce.axis", "axis must be below the dimension");
       if (q == "total" && particles.info(spec.reduce().field()).kind == FieldKind::Vector) {

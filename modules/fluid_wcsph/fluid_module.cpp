@@ -208,6 +208,10 @@ class FluidModule final : public Module {
     const auto* velocity = field("velocity", D, true);
     const auto* volume = field("volume", 1, true);
     const auto* acceleration = field("acceleration", D, false);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!((*volume)[i] > 0.0))
+        throw RuntimeError("module '" + name_ + "': port 'contact': volume of point " +
+                           std::to_string(i) + " is not positive");
     auto& c = contact_.particles;
     if (!c.has("position")) {
       c.add_vector("position", {.output = true});
@@ -222,9 +226,6 @@ class FluidModule final : public Module {
     auto& V = c.scalar("volume");
     for (std::size_t i = 0; i < n; ++i) {
       V[i] = (*volume)[i];
-      if (!(V[i] > 0.0))
-        throw RuntimeError("module '" + name_ + "': port 'contact': volume of point " +
-                           std::to_string(i) + " is not positive");
       for (int d = 0; d < D; ++d) {
         x[i][d] = (*position)[i * D + d];
         v[i][d] = (*velocity)[i * D + d];
@@ -240,6 +241,13 @@ class FluidModule final : public Module {
       const auto raw = fluid_.raw(f);
       state.arrays[f].assign(raw.begin(), raw.end());
     }
+    // Moved walls are where the motion took them, with the velocity and acceleration of their
+    // last sub-step (a restart continues bit for bit).
+    if (walls_.moves)
+      for (const char* f : {"position", "velocity", "acceleration"}) {
+        const auto raw = walls_.particles.raw(f);
+        state.arrays[std::string("wall_") + f].assign(raw.begin(), raw.end());
+      }
     state.scalars["time"] = time_;
     state.integers["steps"] = steps_;
     state.integers["acoustic_steps"] = acoustic_steps_;
@@ -256,6 +264,18 @@ class FluidModule final : public Module {
         throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
                            std::to_string(raw.size()) + " values of '" + f + "'");
       std::copy(it->second.begin(), it->second.end(), raw.begin());
+    }
+    if (walls_.moves) {
+      for (const char* f : {"position", "velocity", "acceleration"}) {
+        const std::string name = std::string("wall_") + f;
+        auto it = state.arrays.find(name);
+        auto raw = walls_.particles.raw(f);
+        if (it == state.arrays.end() || it->second.size() != raw.size())
+          throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
+                             std::to_string(raw.size()) + " values of '" + name + "'");
+        std::copy(it->second.begin(), it->second.end(), raw.begin());
+      }
+      walls_.cells.reset();
     }
     time_ = state.scalars.at("time");
     steps_ = state.integers.at("steps");
@@ -372,16 +392,33 @@ class FluidModule final : public Module {
     if (has_output("wall_force")) walls.add_vector("force", {.output = true});
     wall_owner_ = owner;
     for (const auto& w : wall_velocity_) walls_.moves = walls_.moves || !w.empty();
-    update_wall_velocity(0.0);
+    if (walls_.moves) walls.add_vector("acceleration", {.output = true});
+    update_wall_motion(0.0, 0.0);
   }
 
-  void update_wall_velocity(double t) {
+  // Velocity at t and, for moving walls, acceleration (a centred difference of the prescribed
+  // velocity over `dt`, or over a small fixed interval at a restart): the pressure extension of
+  // an accelerating wall uses g - a_w.
+  void update_wall_motion(double t, double dt) {
     if (walls_.empty()) return;
     auto& v = walls_.particles.vector("velocity");
+    auto* a =
+        walls_.particles.has("acceleration") ? &walls_.particles.vector("acceleration") : nullptr;
+    const double step = dt > 0.0 ? dt : 1e-6;
     for (std::size_t i = 0; i < v.size(); ++i) {
       const auto& expressions = wall_velocity_[wall_owner_[i]];
-      for (int a = 0; a < D; ++a)
-        v[i][a] = expressions.empty() ? 0.0 : expressions[a].evaluate({t});
+      for (int c = 0; c < D; ++c) {
+        if (expressions.empty()) {
+          v[i][c] = 0.0;
+          if (a) (*a)[i][c] = 0.0;
+          continue;
+        }
+        v[i][c] = expressions[c].evaluate({t});
+        if (a)
+          (*a)[i][c] = (expressions[c].evaluate({t + 0.5 * step}) -
+                        expressions[c].evaluate({t - 0.5 * step})) /
+                       step;
+      }
     }
   }
 
@@ -389,7 +426,7 @@ class FluidModule final : public Module {
   // taken at its middle.
   void move_walls(double t, double dt) {
     if (!walls_.moves) return;
-    update_wall_velocity(t + 0.5 * dt);
+    update_wall_motion(t + 0.5 * dt, dt);
     auto& x = walls_.particles.vector("position");
     const auto& v = walls_.particles.vector("velocity");
     for (std::size_t i = 0; i < x.size(); ++i) x[i] += dt * v[i];

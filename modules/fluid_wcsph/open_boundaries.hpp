@@ -5,6 +5,8 @@
 // count.
 #pragma once
 
+#include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -37,6 +39,10 @@ class OpenBoundaries {
       for (int a = 0; a < D; ++a) {
         lower_[a] = in.buffer().lower(a);
         upper_[a] = in.buffer().upper(a);
+        if (!(lower_[a] < upper_[a]))
+          throw ConfigError(
+              path + ".buffer",
+              "the box needs lower < upper along every axis (axis " + std::to_string(a) + ")");
       }
       if (!(length() >= support))
         throw ConfigError(path + ".buffer", "the buffer must be at least one kernel support (" +

@@ -32,13 +32,16 @@ class DominantOscillation(unittest.TestCase):
 
 
 class SeriesPreparation(unittest.TestCase):
-    def test_window_cuts_and_smoothing_averages(self):
+    def test_window_cuts_and_smoothing_is_centred(self):
         t = np.arange(0.0, 1.0001, 0.01)
-        series = np.where(np.arange(t.size) % 2 == 0, 1.0, -1.0)  # alternating noise
-        times, values = study._prepare_series(quantity(smooth=0.02, window=(0.2, 0.8)), t, series)
+        # A centred average leaves a straight line unchanged; an off-centre one would shift it.
+        times, values = study._prepare_series(quantity(smooth=0.02, window=(0.2, 0.8)), t, 2 * t)
         self.assertAlmostEqual(times[0], 0.2)
         self.assertAlmostEqual(times[-1], 0.8)
-        self.assertTrue(np.all(np.abs(values) < 1e-12))  # a 2-sample average removes it
+        self.assertTrue(np.allclose(values, 2 * times, atol=1e-12))
+        noisy = np.where(np.arange(t.size) % 2 == 0, 1.0, -1.0)
+        _, smoothed = study._prepare_series(quantity(smooth=0.1, window=(0.2, 0.8)), t, noisy)
+        self.assertLess(np.max(np.abs(smoothed)), 0.1)
 
     def test_empty_window_is_an_error(self):
         with self.assertRaises(study.ComparisonError):
@@ -60,6 +63,17 @@ class RunKey(unittest.TestCase):
             scene.write_text("end_time: 1\n")
             exe.write_bytes(b"binary 2")
             self.assertNotEqual(key, study.run_key(exe, scene, {"a": 1}, 1))
+
+    def test_depends_on_the_files_the_scene_names(self):
+        with tempfile.TemporaryDirectory() as directory:
+            exe, scene = Path(directory) / "cosph", Path(directory) / "scene.yaml"
+            table = Path(directory) / "fibres.csv"
+            exe.write_bytes(b"binary")
+            scene.write_text("fibres: {csv: fibres.csv}\n")
+            table.write_text("x,y,f\n0,0,1\n")
+            key = study.run_key(exe, scene, {}, 1)
+            table.write_text("x,y,f\n0,0,2\n")
+            self.assertNotEqual(key, study.run_key(exe, scene, {}, 1))
 
 
 if __name__ == "__main__":

@@ -84,7 +84,7 @@ TEST(FluidOpenBoundary, ChannelStaysFullAndFlowsAtTheInflowSpeed) {
             << highest << "], mean u over the cross-section " << u << "\n";
   EXPECT_NEAR(double(p.size()), double(initial), 0.05 * initial);
   EXPECT_GE(lowest, -0.2);  // nothing leaks upstream out of the buffer
-  EXPECT_LE(highest, 2.0);  // everything past the outflow plane has gone
+  EXPECT_GT(highest, 1.9);  // the channel is full up to the outflow plane
   EXPECT_GT(middle, 300);
   EXPECT_NEAR(u, 1.0, 0.05);  // the flux through the channel is the inflow's
 }
@@ -139,7 +139,7 @@ TEST(FluidOpenBoundary, DuctIn3DStaysFullAndFlows) {
   std::cout << "duct: particles " << initial << " -> " << p.size() << ", mean u " << u << "\n";
   EXPECT_NEAR(double(p.size()), double(initial), 0.08 * initial);
   EXPECT_GE(lowest, -0.3);
-  EXPECT_LE(highest, 1.0);
+  EXPECT_GT(highest, 0.85);  // full up to the outflow plane
   EXPECT_NEAR(u, 1.0, 0.1);
 }
 
@@ -259,6 +259,8 @@ TEST(FluidOpenBoundary, BadInputNamesTheKey) {
   const std::string short_buffer = message({"modules[0].fluid.inflow.buffer.lower=[-0.1, 0]"});
   EXPECT_NE(short_buffer.find("modules[0].fluid.inflow.buffer"), std::string::npos) << short_buffer;
   EXPECT_NE(message({"modules[0].fluid.inflow.axis=2"}).find("inflow.axis"), std::string::npos);
+  EXPECT_NE(message({"modules[0].fluid.inflow.buffer.upper=[0, 0]"}).find("lower < upper"),
+            std::string::npos);
   EXPECT_NE(message({"modules[0].fluid.outflow.axis=2"}).find("outflow.axis"), std::string::npos);
   EXPECT_NE(message({"modules[0].fluid.inflow.velocity[0]=1 +"}).find("inflow.velocity[0]"),
             std::string::npos);

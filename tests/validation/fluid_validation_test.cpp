@@ -228,8 +228,9 @@ TEST(FluidValidation, CylinderSheddingAtRe100MatchesTheBenchmark) {
   const double strouhal = best_f * 0.1;
   std::cout << "cylinder, D/10: St " << strouhal << " (0.295-0.305), mean C_D " << mean_drag
             << " (largest 3.22-3.24), C_L amplitude " << best_amplitude << " (0.99-1.01)\n";
-  EXPECT_NEAR(strouhal, 0.30, 0.12 * 0.30);   // measured 0.272
-  EXPECT_NEAR(mean_drag, 3.23, 0.15 * 3.23);  // measured 3.58
+  EXPECT_NEAR(strouhal, 0.30, 0.12 * 0.30);  // measured 0.272
+  // The mean drag against the published largest value: the drag varies by ~1% over a cycle.
+  EXPECT_NEAR(mean_drag, 3.23, 0.15 * 3.23);  // measured 3.56
   EXPECT_GT(best_amplitude, 0.4);             // measured 0.60: the street has formed
   EXPECT_LT(best_amplitude, 1.3);
 }
