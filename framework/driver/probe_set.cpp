@@ -63,8 +63,7 @@ struct ReductionEntry : ProbeSet::Probe {
     if (q == "extent") return {extent<D>(p, spec.axis())};
     if (q == "front") return {front<D>(p, spec.axis())};
     if (q == "surface_height")
-      return {
-          surface_height<D>(p, to_vec<D>(spec.at()), spec.axis(), body->kernel.smoothing_length())};
+      return {surface_height<D>(p, body->kernel, to_vec<D>(spec.at()), spec.axis())};
     if (q == "integral") return {integral<D>(p, spec.field())};
     if (q == "total") {
       if (spec.has_within()) return total_within(p);

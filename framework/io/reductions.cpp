@@ -19,18 +19,41 @@ double total_kinetic_energy(const ParticleSet<D>& particles) {
 }
 
 template <int D>
-double surface_height(const ParticleSet<D>& particles, const Vec<D>& at, int axis,
-                      double half_width) {
+double surface_height(const ParticleSet<D>& particles, const Kernel& kernel, const Vec<D>& at,
+                      int axis) {
   const auto& x = required_vector(particles, "position", "a surface height");
   const auto& V = required_scalar(particles, "volume", "a surface height");
+  const double support = kernel.support_radius(), h = kernel.smoothing_length();
+  // The particles that can contribute anywhere on the gauge line.
+  std::vector<std::size_t> near;
   double top = -INFINITY;
   for (std::size_t i = 0; i < x.size(); ++i) {
-    bool inside = true;
+    double lateral = 0.0;
     for (int a = 0; a < D; ++a)
-      if (a != axis && std::abs(x[i][a] - at[a]) > half_width) inside = false;
-    if (inside) top = std::max(top, x[i][axis] + 0.5 * std::pow(V[i], 1.0 / D));
+      if (a != axis) lateral += (x[i][a] - at[a]) * (x[i][a] - at[a]);
+    if (lateral < support * support && x[i][axis] > at[axis] - support) {
+      near.push_back(i);
+      top = std::max(top, x[i][axis]);
+    }
   }
-  return std::isfinite(top) ? top : std::numeric_limits<double>::quiet_NaN();
+  if (near.empty()) return at[axis];
+  auto fraction = [&](double level) {
+    Vec<D> p = at;
+    p[axis] = level;
+    double sum = 0.0;
+    for (std::size_t i : near) sum += V[i] * kernel.value((p - x[i]).norm());
+    return sum;
+  };
+  const double step = h / 8.0;
+  double level = at[axis] + h, below = fraction(level);
+  if (below < 0.5) return at[axis];  // dry, or a film thinner than h
+  while (level < top + support) {
+    const double above = fraction(level + step);
+    if (above < 0.5) return level + step * (below - 0.5) / (below - above);
+    level += step;
+    below = above;
+  }
+  return level;
 }
 
 template <int D>
@@ -81,13 +104,13 @@ double integral(const ParticleSet<D>& particles, const std::string& scalar_field
   return deterministic_sum(particles.size(), 0.0, [&](std::size_t i) { return volume[i] * f[i]; });
 }
 
-#define COSPH_INSTANTIATE_REDUCTIONS(D)                                                 \
-  template double total_kinetic_energy<D>(const ParticleSet<D>&);                       \
-  template double extent<D>(const ParticleSet<D>&, int);                                \
-  template double front<D>(const ParticleSet<D>&, int);                                 \
-  template double surface_height<D>(const ParticleSet<D>&, const Vec<D>&, int, double); \
-  template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&);           \
-  template double total_scalar<D>(const ParticleSet<D>&, const std::string&);           \
+#define COSPH_INSTANTIATE_REDUCTIONS(D)                                                        \
+  template double total_kinetic_energy<D>(const ParticleSet<D>&);                              \
+  template double extent<D>(const ParticleSet<D>&, int);                                       \
+  template double front<D>(const ParticleSet<D>&, int);                                        \
+  template double surface_height<D>(const ParticleSet<D>&, const Kernel&, const Vec<D>&, int); \
+  template Vec<D> total_vector<D>(const ParticleSet<D>&, const std::string&);                  \
+  template double total_scalar<D>(const ParticleSet<D>&, const std::string&);                  \
   template double integral<D>(const ParticleSet<D>&, const std::string&);
 COSPH_INSTANTIATE_REDUCTIONS(2)
 COSPH_INSTANTIATE_REDUCTIONS(3)

@@ -192,21 +192,33 @@ probes:
   }
 }
 
-// Wave gauge: the top of the highest particle within the band around the gauge line; NaN when dry.
+// Wave gauge: the top of the continuous water column under the gauge, where the kernel-summed
+// volume fraction falls to 1/2; a drop above the column does not count; the base when dry.
 TEST(SurfaceHeight, GaugeReadsTheTopOfTheWaterColumnUnderIt) {
-  ParticleSet<2> water("water");
-  const double dp = 0.1;
-  std::vector<Vec<2>> x;
-  for (int i = 0; i < 10; ++i)
-    for (int j = 0; j < 10 - i / 2; ++j)  // a staircase: columns get lower to the right
-      x.push_back(Vec<2>((i + 0.5) * dp, (j + 0.5) * dp));
-  water.resize(x.size());
-  water.add_vector("position") = x;
-  water.add_scalar("volume").assign(x.size(), dp * dp);
-  // Column i = 0 (x = 0.05) holds 10 particles: top at 1.0; column i = 6 holds 7: top at 0.7.
-  EXPECT_NEAR(surface_height<2>(water, Vec<2>(0.05, 0.0), 1, 0.4 * dp), 1.0, 1e-12);
-  EXPECT_NEAR(surface_height<2>(water, Vec<2>(0.65, 0.0), 1, 0.4 * dp), 0.7, 1e-12);
-  EXPECT_TRUE(std::isnan(surface_height<2>(water, Vec<2>(2.0, 0.0), 1, 0.4 * dp)));
+  const double dp = 0.05;
+  const Kernel kernel(KernelType::WendlandC2, 2, 1.3 * dp);
+  auto block = [&](double height, bool drop) {
+    ParticleSet<2> water("water");
+    std::vector<Vec<2>> x;
+    for (int i = 0; i < 40; ++i)
+      for (int j = 0; (j + 0.5) * dp < height; ++j)
+        x.push_back(Vec<2>((i + 0.5) * dp, (j + 0.5) * dp));
+    if (drop) x.push_back(Vec<2>(1.0 + 0.5 * dp, height + 0.5));  // a lone drop 0.5 above
+    water.resize(x.size());
+    water.add_vector("position") = x;
+    water.add_scalar("volume").assign(x.size(), dp * dp);
+    return water;
+  };
+  for (double height : {1.0, 0.6}) {
+    const ParticleSet<2> water = block(height, false);
+    const double level = surface_height<2>(water, kernel, Vec<2>(1.0, 0.0), 1);
+    std::cout << "column " << height << ": gauge reads " << level << "\n";
+    EXPECT_NEAR(level, height, 0.25 * dp);
+    EXPECT_NEAR(surface_height<2>(block(height, true), kernel, Vec<2>(1.0, 0.0), 1), level, 1e-12);
+  }
+  // Dry: beyond the water, and a gauge whose base is given at y = -0.3.
+  EXPECT_EQ(surface_height<2>(block(1.0, false), kernel, Vec<2>(3.0, 0.0), 1), 0.0);
+  EXPECT_EQ(surface_height<2>(block(1.0, false), kernel, Vec<2>(3.0, -0.3), 1), -0.3);
 }
 
 }  // namespace
