@@ -603,6 +603,7 @@ class PointResult:
     sample: Optional[Sample] = None
     reference_values: Optional[np.ndarray] = None
     arrivals: Optional[tuple] = None  # (simulated, reference) arrival times
+    reused: bool = False  # taken from the run cache, not run by this invocation
 
 
 def format_value(value: Any) -> str:
@@ -687,7 +688,7 @@ def run_point(study: Study, point: Point, cosph: Path, out_dir: Path, repeat: in
             shutil.rmtree(out_dir)
         try:
             best_summary = json.loads((out_dir / "summary.json").read_text())
-            result.message = "reused"
+            result.message, result.reused = "reused", True
         except (OSError, ValueError):
             best_summary = None
     for _ in range(0 if best_summary is not None else repeat):
@@ -714,7 +715,7 @@ def run_point(study: Study, point: Point, cosph: Path, out_dir: Path, repeat: in
             return result
         if best_summary is None or summary["wall_seconds"] < best_summary["wall_seconds"]:
             best_summary = summary
-    if cache is not None and result.message != "reused":
+    if cache is not None and not result.reused:
         (out_dir / "summary.json").write_text(json.dumps(best_summary))
     for name in ("wall_seconds", "cpu_seconds", "particles", "steps",
                  "particle_steps_per_second", "threads"):

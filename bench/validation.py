@@ -172,8 +172,11 @@ def observed_order(study: studies.Study, results: list, best) -> str:
     spacing = next((a for a in study.axes if a.key.endswith("spacing")), None)
     if best is None or spacing is None:
         return "–"
+    if spacing.label not in best.point.axis_values:
+        return "–"  # the best point is an explicit point outside the sweep
     same = [r for r in results if r.status == "ok" and math.isfinite(r.error) and r.error > 0
-            and all(v == best.point.axis_values[k] for k, v in r.point.axis_values.items()
+            and spacing.label in r.point.axis_values  # explicit points have no axis values
+            and all(v == best.point.axis_values.get(k) for k, v in r.point.axis_values.items()
                     if k != spacing.label)]
     same.sort(key=lambda r: r.point.axis_values[spacing.label])
     if len(same) < 2:
@@ -209,7 +212,13 @@ def write_document(path: Path, runs: list, machine: list, seconds: float) -> Non
              "`bench/study.py` and compares a probe with a reference; every number below comes "
              "from this regeneration.", ""]
     lines += machine
-    lines += [f"- **Run time:** {seconds:.1f} s for {len(runs)} studies", "",
+    points = [r for run in runs for r in run.results]
+    reused = sum(r.reused for r in points)
+    lines += [f"- **Run time:** {seconds:.1f} s for {len(runs)} studies"
+              + (f"; {reused} of {len(points)} points reused runs kept in bench/results/runs/ "
+                 "(the same executable, scene, files, overrides and machine; their wall times "
+                 "are those of the original runs, made under the load of their own time)"
+                 if reused else ""), "",
               "## Summary", ""]
     lines += summary_lines(runs)
     lines.append("")
