@@ -123,7 +123,8 @@ def main() -> None:
         for b in rows:
             label, size = b["name"].split("/")[0], b["name"].split("/")[1]
             rate = b.get("items_per_second", float("nan"))
-            extra = f" {b['bytes_per_particle']:.0f} |" if memory else ""
+            extra = ((f" {b['bytes_per_particle']:.0f} |" if "bytes_per_particle" in b else " – |")
+                     if memory else "")
             lines.append(f"| `{label}` | {int(b.get('particles', int(size))):,} | {b['real_time']:.3g} {b['time_unit']} | {rate / 1e6:.3g} M |" + extra)
         lines.append("")
     lines += fluid_share_lines(fluid_rows)
