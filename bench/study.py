@@ -771,25 +771,16 @@ def extract_sample(quantity: Quantity, out_dir: Path) -> Sample:
     origin = next(iter(coordinates.values()), None)
     xyz = coordinates.get(label, (math.nan,) * 3)
     distance = math.dist(xyz, origin) if origin and label in coordinates else math.nan
-    if quantity.kind == "period":
-        return _period_sample(quantity, times, series, xyz, distance)
-    if quantity.kind in ("mean", "maximum", "amplitude", "dominant_period", "dominant_amplitude"):
-        if quantity.kind.startswith("dominant_"):
-            period, amplitude = dominant_oscillation(times, series)
-            value = period if quantity.kind == "dominant_period" else amplitude
-        else:
-            value = {"mean": np.mean, "maximum": np.max,
-                     "amplitude": lambda s: 0.5 * (np.max(s) - np.min(s))}[quantity.kind](series)
-        t = times[-1:]
-        variables = {"x": np.full_like(t, xyz[0]), "y": np.full_like(t, xyz[1]),
-                     "z": np.full_like(t, xyz[2]), "t": t, "distance": np.full_like(t, distance)}
-        return Sample(np.array([value]), variables, t, "time", quantity.kind)
+    name = _field_of(quantity.column)
+    if quantity.kind in SCALAR_KINDS:  # one value of the series, placed at its last time
+        value = SERIES_VALUES[quantity.kind](quantity, times, series)
+        times, series, name = times[-1:], np.array([value]), quantity.kind
     if quantity.kind == "final":
         times, series = times[-1:], series[-1:]
     variables = {"x": np.full_like(times, xyz[0]), "y": np.full_like(times, xyz[1]),
                  "z": np.full_like(times, xyz[2]), "t": times,
                  "distance": np.full_like(times, distance)}
-    return Sample(series, variables, times, "time", _field_of(quantity.column))
+    return Sample(series, variables, times, "time", name)
 
 
 def dominant_oscillation(times, series) -> tuple:
@@ -836,7 +827,7 @@ def _prepare_series(quantity: Quantity, times, series) -> tuple:
     return times, series
 
 
-def _period_sample(quantity: Quantity, times, series, xyz, distance) -> Sample:
+def _mean_period(quantity: Quantity, times, series) -> float:
     """Mean period between the first and last downward zero crossings of the series."""
     down = np.nonzero((series[:-1] > 0.0) & (series[1:] <= 0.0))[0]
     if len(down) < 2:
@@ -844,11 +835,18 @@ def _period_sample(quantity: Quantity, times, series, xyz, distance) -> Sample:
                               "a period needs two crossings (run longer)")
     t0, t1, v0, v1 = times[down], times[down + 1], series[down], series[down + 1]
     crossings = t0 + v0 * (t1 - t0) / (v0 - v1)
-    value = (crossings[-1] - crossings[0]) / (len(crossings) - 1)
-    t = times[-1:]
-    variables = {"x": np.full_like(t, xyz[0]), "y": np.full_like(t, xyz[1]),
-                 "z": np.full_like(t, xyz[2]), "t": t, "distance": np.full_like(t, distance)}
-    return Sample(np.array([value]), variables, t, "time", "period")
+    return float((crossings[-1] - crossings[0]) / (len(crossings) - 1))
+
+
+# The one value each scalar kind takes from a (windowed, smoothed, scaled) time series.
+SERIES_VALUES = {
+    "period": _mean_period,
+    "mean": lambda q, t, s: float(np.mean(s)),
+    "maximum": lambda q, t, s: float(np.max(s)),
+    "amplitude": lambda q, t, s: 0.5 * float(np.max(s) - np.min(s)),
+    "dominant_period": lambda q, t, s: dominant_oscillation(t, s)[0],
+    "dominant_amplitude": lambda q, t, s: dominant_oscillation(t, s)[1],
+}
 
 
 def _combined_sample(quantity: Quantity, times, columns, values) -> Sample:
@@ -1035,20 +1033,13 @@ def quantity_text(quantity: Quantity) -> str:
         extra += f", moving average over {quantity.smooth:g}"
     if quantity.window is not None:
         extra += f", t in [{quantity.window[0]:g}, {quantity.window[1]:g}]"
-    if quantity.kind == "time_series":
-        return f"{name}time series of {quantity.column}{extra}"
-    if quantity.kind == "period":
-        return f"{name}mean period of the downward zero crossings of {quantity.column}{extra}"
-    if quantity.kind == "mean":
-        return f"{name}time mean of {quantity.column}{extra}"
-    if quantity.kind == "maximum":
-        return f"{name}largest value of {quantity.column}{extra}"
-    if quantity.kind == "amplitude":
-        return f"{name}half the peak-to-peak range of {quantity.column}{extra}"
-    if quantity.kind == "dominant_period":
-        return f"{name}period of the strongest sinusoid in {quantity.column}{extra}"
-    if quantity.kind == "dominant_amplitude":
-        return f"{name}amplitude of the strongest sinusoid in {quantity.column}{extra}"
+    what = {"time_series": "time series of", "period": "mean period of the downward zero "
+            "crossings of", "mean": "time mean of", "maximum": "largest value of",
+            "amplitude": "half the peak-to-peak range of",
+            "dominant_period": "period of the strongest sinusoid in",
+            "dominant_amplitude": "amplitude of the strongest sinusoid in"}
+    if quantity.kind in what:
+        return f"{name}{what[quantity.kind]} {quantity.column}{extra}"
     return f"{name}final value of {quantity.column}"
 
 
