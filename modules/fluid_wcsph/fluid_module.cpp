@@ -669,6 +669,24 @@ class FluidModule final : public Module {
 
   Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
 
+  // Calls f(e_iw, -dW/dr, V_w, one-sided state of w) for every boundary neighbour w of fluid
+  // particle i (at x, with pressure p, density rho, velocity v), with the pair geometry of the
+  // advection step (the two acoustic halves share it).
+  template <typename F>
+  void for_each_boundary_neighbour(std::size_t i, const Vec<D>& x, double p, double rho,
+                                   const Vec<D>& v, const std::vector<const BoundarySet<D>*>& sets,
+                                   const std::vector<BoundaryView>& views, const F& f) const {
+    for (std::size_t s = 0; s < sets.size(); ++s) {
+      const BoundarySet<D>& b = *sets[s];
+      const BoundaryView& view = views[s];
+      for (std::size_t k = b.list.offset[i]; k < b.list.offset[i + 1]; ++k) {
+        const Index w = b.list.index[k];
+        f(b.geometry.direction[k], b.geometry.gradient[k], view.V[w],
+          view.state(w, p, rho, v, domain_.displacement(view.x[w], x)));
+      }
+    }
+  }
+
   // First half: density and position to mid-step, velocity over the step from P*.
   void pressure_relaxation(double t, double dt) {
     auto& x = fluid_.vector("position");
@@ -698,18 +716,13 @@ class FluidModule final : public Module {
         const double P = solver.pressure(p[i], p[j], v[i].dot(e), v[j].dot(e));
         sum -= (volume[j] * P * inner_geometry_.gradient[k]) * e;
       }
-      for (std::size_t s = 0; s < sets.size(); ++s) {
-        const BoundarySet<D>* b = sets[s];
-        const BoundaryView& view = views[s];
-        for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
-          const Index w = b->list.index[k];
-          const Vec<D>& e = b->geometry.direction[k];
-          const auto wall =
-              view.state(w, p[i], rho[i], v[i], domain_.displacement(view.x[w], x[i]));
-          const double P = solver.pressure(p[i], wall.pressure, v[i].dot(e), wall.velocity.dot(e));
-          sum -= (view.V[w] * P * b->geometry.gradient[k]) * e;
-        }
-      }
+      for_each_boundary_neighbour(
+          i, x[i], p[i], rho[i], v[i], sets, views,
+          [&](const Vec<D>& e, double gradient, double V, const auto& wall) {
+            const double P =
+                solver.pressure(p[i], wall.pressure, v[i].dot(e), wall.velocity.dot(e));
+            sum -= (V * P * gradient) * e;
+          });
       dv_[i] = (2.0 / rho[i]) * sum;
     });
     parallel_for_each_index(x.size(), [&](std::size_t i) { v[i] += dt * (dv_[i] + prior[i]); });
@@ -738,19 +751,13 @@ class FluidModule final : public Module {
         const double U = solver.velocity(p[i], p[j], u, v[j].dot(e));
         sum += volume[j] * (u - U) * inner_geometry_.gradient[k];
       }
-      for (std::size_t s = 0; s < sets.size(); ++s) {
-        const BoundarySet<D>* b = sets[s];
-        const BoundaryView& view = views[s];
-        for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
-          const Index w = b->list.index[k];
-          const Vec<D>& e = b->geometry.direction[k];
-          const auto wall =
-              view.state(w, p[i], rho[i], v[i], domain_.displacement(view.x[w], x[i]));
-          const double u = v[i].dot(e);
-          const double U = solver.velocity(p[i], wall.pressure, u, wall.velocity.dot(e));
-          sum += view.V[w] * (u - U) * b->geometry.gradient[k];
-        }
-      }
+      for_each_boundary_neighbour(
+          i, x[i], p[i], rho[i], v[i], sets, views,
+          [&](const Vec<D>& e, double gradient, double V, const auto& wall) {
+            const double u = v[i].dot(e);
+            const double U = solver.velocity(p[i], wall.pressure, u, wall.velocity.dot(e));
+            sum += V * (u - U) * gradient;
+          });
       drho[i] = 2.0 * rho[i] * sum;
     });
     parallel_for_each_index(x.size(), [&](std::size_t i) { rho[i] += 0.5 * dt * drho[i]; });
