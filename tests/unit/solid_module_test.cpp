@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/simulation_setup.hpp"
 #include "core/error.hpp"
 #include "driver/simulation.hpp"
 #include "module_catalogue.hpp"
@@ -24,27 +25,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A scene loaded from text, initialised, ready to run.
-std::unique_ptr<Simulation> make_simulation(const std::string& text,
-                                            const std::vector<std::string>& overrides = {},
-                                            RunOptions options = {}) {
-  if (options.output_directory.empty()) options.bench = true;
-  options.progress = false;
-  auto simulation = std::make_unique<Simulation>(load_scene_text(text, "solid.yaml", overrides),
-                                                 builtin_modules(), options);
-  simulation->initialize();
-  return simulation;
-}
-
-template <int D>
-const ParticleSet<D>& particles_of(Simulation& simulation) {
-  BodyViews views;
-  simulation.module(0).bodies(views);
-  if constexpr (D == 2)
-    return *views.bodies2.at(0).particles;
-  else
-    return *views.bodies3.at(0).particles;
-}
+using test::make_simulation;
+using test::particles_of;
 
 fs::path temp_dir(const std::string& name) {
   fs::path dir = fs::temp_directory_path() / ("cosph_solid_module_test_" + name);
