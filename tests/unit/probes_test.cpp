@@ -417,6 +417,11 @@ TEST(Reductions, HandComputedValues2D) {
   EXPECT_DOUBLE_EQ(integral(body, "c"), 0.5 * 2.0 + 0.25 * 4.0 + 2.0 * 1.0);
   EXPECT_THROW(extent(body, 2), std::invalid_argument);
   EXPECT_THROW(extent(body, -1), std::invalid_argument);
+  // The leading edge: the largest x + V^(1/2) / 2, here particle 1's 2 + 0.25 (particle 2,
+  // 0.5 + 0.707, is behind it); along y, 4.5 + 0.25.
+  EXPECT_DOUBLE_EQ(front(body, 0), 2.25);
+  EXPECT_DOUBLE_EQ(front(body, 1), 4.75);
+  EXPECT_THROW(front(body, 2), std::invalid_argument);
 }
 
 TEST(Reductions, HandComputedValues3D) {
