@@ -2,6 +2,7 @@
 
 #include "active_stress/active_stress_module.hpp"
 #include "diffusion/diffusion_module.hpp"
+#include "fsi/fsi_coupler.hpp"
 #include "fluid_wcsph/fluid_module.hpp"
 #include "monodomain/monodomain_module.hpp"
 #include "solid_tlsph/solid_module.hpp"
@@ -16,6 +17,7 @@ const ModuleRegistry& builtin_modules() {
     r.add("active_stress", make_active_stress_module);
     r.add("solid", make_solid_module);
     r.add("fluid", make_fluid_module);
+    r.couplers().add("fsi", {"fluid", "solid"}, make_fsi_coupler);
     return r;
   }();
   return registry;

@@ -44,9 +44,9 @@ void check_body(const BodyView<D>& view, bool check_domain, unsigned long long s
 
 }  // namespace
 
-void HealthMonitor::check(const std::vector<std::unique_ptr<Module>>& modules,
-                          unsigned long long step, double time) const {
-  for (const auto& m : modules) {
+void HealthMonitor::check(const std::vector<const Module*>& modules, unsigned long long step,
+                          double time) const {
+  for (const Module* m : modules) {
     BodyViews views;
     m->bodies(views);
     for (const auto& b : views.bodies2) check_body<2>(b, check_domain_, step, time);

@@ -25,7 +25,8 @@ class HealthMonitor {
   bool due(unsigned long long step) const { return interval_ > 0 && step % interval_ == 0; }
   bool enabled() const { return interval_ > 0; }
   // Throws HealthError on the first problem found.
-  void check(const std::vector<std::unique_ptr<Module>>& modules, unsigned long long step,
+  // Every scene module (the leaves of the coupler tree: their health is their own).
+  void check(const std::vector<const Module*>& modules, unsigned long long step,
              double time) const;
 
  private:

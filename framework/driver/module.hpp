@@ -31,6 +31,8 @@ struct ModuleInfo {
   // scene pays only for what it names, and the summary shows exactly that.
   std::vector<std::string> active_features;
   std::vector<std::string> children;  // modules a coupler owns
+  int dimension = 0;                  // 2 or 3
+  double spacing = 0.0;               // particle spacing of its main body (0: none)
 };
 
 // Data through a port: `points` entries of each named array, `components` doubles per entry.
@@ -43,11 +45,16 @@ struct FieldBuffer {
   std::map<std::string, Array> arrays;
 };
 
-// The complete state of a module, for checkpoints (bit-exact restart) and remote transport.
+// The complete state of a module, for checkpoints (bit-exact restart) and remote transport. A
+// coupler's record holds its own state and one child record per module it owns (named by the
+// child), so a coupled checkpoint is complete by construction and nests as couplers do.
 struct StateRecord {
+  std::string name;  // of the module whose state this is (set for child records)
+  std::string type;
   std::map<std::string, std::vector<double>> arrays;
   std::map<std::string, double> scalars;
   std::map<std::string, long long> integers;
+  std::vector<StateRecord> children;
 };
 
 // A violated physical bound, found by a module's own health check.
@@ -86,6 +93,21 @@ class Module {
   virtual void advance(double dt) = 0;
   virtual double time() const = 0;
 
+  // Staged advance: one step of Dt as sub-steps that a coupler drives and interleaves with its
+  // exchanges (FSI exchanges forces at every acoustic sub-step of the fluid's advection step).
+  // begin_step(Dt) opens the step; max_substep() is the largest next sub-step (0 once the step is
+  // covered); substep(dt) advances by it; end_step() closes the step. Between begin_step and
+  // end_step the module reads and writes its ports as usual; a checkpoint is taken only between
+  // steps. Every call is a plain value exchange, so a remote module forwards it unchanged. A
+  // module without inner sub-steps keeps the defaults: one sub-step that is its whole advance.
+  virtual void begin_step(double Dt) { staged_remaining_ = Dt; }
+  virtual double max_substep() const { return staged_remaining_; }
+  virtual void substep(double dt) {
+    advance(dt);
+    staged_remaining_ = dt >= staged_remaining_ ? 0.0 : staged_remaining_ - dt;
+  }
+  virtual void end_step() { staged_remaining_ = 0.0; }
+
   virtual void write(const std::string& port, FieldBuffer& out) const = 0;
   virtual void read(const std::string& port, const FieldBuffer& in) = 0;
 
@@ -103,6 +125,16 @@ class Module {
   // The module's own physical bounds (J > 0, density band, maximum principle...). The health
   // monitor checks finiteness and the domain for every module itself.
   virtual std::optional<HealthProblem> check_health() const { return std::nullopt; }
+
+ private:
+  double staged_remaining_ = 0.0;  // the default staging's open step
 };
+
+// A whole step through the staged calls: what advance() is for a module that implements stages.
+inline void advance_in_substeps(Module& module, double Dt) {
+  module.begin_step(Dt);
+  for (double dt = module.max_substep(); dt > 0.0; dt = module.max_substep()) module.substep(dt);
+  module.end_step();
+}
 
 }  // namespace cosph

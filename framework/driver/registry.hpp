@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "driver/coupler_registry.hpp"
 #include "driver/module.hpp"
 #include "scene.pb.h"
 
@@ -30,8 +31,13 @@ class ModuleRegistry {
   std::unique_ptr<Module> create(const std::string& type, const proto::ModuleSpec& spec,
                                  const ModuleContext& context) const;
 
+  // The coupler types that scenes built with these modules may use.
+  CouplerRegistry& couplers() { return couplers_; }
+  const CouplerRegistry& couplers() const { return couplers_; }
+
  private:
   std::map<std::string, ModuleFactory> factories_;
+  CouplerRegistry couplers_;
 };
 
 // The type of a module spec: the name of the oneof member that is set ("" if none).

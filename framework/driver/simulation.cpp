@@ -18,6 +18,7 @@
 #include "core/error.hpp"
 #include "driver/health_monitor.hpp"
 #include "driver/probe_set.hpp"
+#include "driver/state_codec.hpp"
 #include "io/checkpoint_file.hpp"
 #include "io/pvd_collection.hpp"
 #include "io/vtp_writer.hpp"
@@ -71,6 +72,7 @@ double peak_resident_bytes() {
 std::string fingerprint(const proto::Scene& scene) {
   std::string bytes = std::to_string(scene.dimension());
   for (const auto& m : scene.modules()) bytes += m.SerializeAsString();
+  for (const auto& c : scene.couplers()) bytes += c.SerializeAsString();
   if (scene.has_domain()) bytes += scene.domain().SerializeAsString();
   std::ostringstream s;
   s << std::hex << fnv1a64(bytes);
@@ -103,6 +105,19 @@ std::string RunSummary::to_json() const {
       << ", \"advance_seconds\": " << json_number(m.advance_seconds) << ", \"features\": [";
     for (std::size_t f = 0; f < m.features.size(); ++f)
       j << (f ? ", " : "") << "\"" << json_escape(m.features[f]) << "\"";
+    j << "]}";
+  }
+  j << "\n  ],\n  \"couplers\": [";
+  for (std::size_t k = 0; k < couplers.size(); ++k) {
+    const auto& c = couplers[k];
+    j << (k ? "," : "") << "\n    {\"name\": \"" << json_escape(c.name) << "\", \"type\": \""
+      << json_escape(c.type) << "\", \"advance_seconds\": " << json_number(c.advance_seconds)
+      << ", \"own_seconds\": " << json_number(c.own_seconds) << ", \"children\": [";
+    for (std::size_t f = 0; f < c.children.size(); ++f)
+      j << (f ? ", " : "") << "\"" << json_escape(c.children[f]) << "\"";
+    j << "], \"features\": [";
+    for (std::size_t f = 0; f < c.features.size(); ++f)
+      j << (f ? ", " : "") << "\"" << json_escape(c.features[f]) << "\"";
     j << "]}";
   }
   j << "\n  ],\n  \"outputs\": [";
@@ -138,7 +153,6 @@ struct Simulation::Impl {
   double time = 0.0;
   unsigned long long steps = 0;
   double output_seconds = 0.0;
-  std::vector<double> advance_seconds;
 };
 
 Simulation::Simulation(LoadedScene scene, const ModuleRegistry& registry, RunOptions options)
@@ -165,6 +179,7 @@ void Simulation::initialize() {
           throw ConfigError("modules[" + std::to_string(k) + "].name",
                             "two modules named '" + s.modules(k).name() + "'");
     }
+    std::vector<std::unique_ptr<Module>> modules;
     for (int k = 0; k < s.modules_size(); ++k) {
       const auto& spec = s.modules(k);
       ModuleContext context{&s, "modules[" + std::to_string(k) + "]", scene_.source.directory()};
@@ -177,9 +192,10 @@ void Simulation::initialize() {
             "only 'local' modules are available in this build (got '" + spec.where() + "')");
       auto module = registry_.create(type, spec, context);
       module->initialize();
-      modules_.push_back(std::move(module));
+      modules.push_back(std::move(module));
     }
-    for (const auto& m : modules_) {
+    tree_ = assemble_module_tree(s, std::move(modules), registry_.couplers());
+    for (const TimedModule* m : tree_.modules) {
       BodyViews v;
       m->bodies(v);
       impl_->views.emplace_back(m->info().name, v);
@@ -195,7 +211,6 @@ void Simulation::initialize() {
   } catch (const ConfigError& e) {
     throw SceneError(e.key_path(), scene_.source.format(e));
   }
-  impl_->advance_seconds.assign(modules_.size(), 0.0);
   impl_->output.interval = s.output().interval();
   impl_->checkpoint.interval = s.checkpoint().interval();
   for (std::size_t k = 0; k < impl_->probes->size(); ++k)
@@ -215,7 +230,7 @@ RunSummary Simulation::run() {
   long long prepared_steps = -1;
   auto prepare_output = [&](double t) {
     if (t == prepared_time && static_cast<long long>(I.steps) == prepared_steps) return;
-    for (auto& m : modules_) m->prepare_output();
+    for (auto& m : tree_.roots) m->prepare_output();
     prepared_time = t;
     prepared_steps = static_cast<long long>(I.steps);
   };
@@ -262,19 +277,13 @@ RunSummary Simulation::run() {
     for (std::size_t k = 0; k < I.probe_schedules.size(); ++k)
       (*c.mutable_driver_scalars())["probe_next_" + std::to_string(k)] =
           static_cast<double>(I.probe_schedules[k].next);
-    for (const auto& m : modules_) {
+    for (const auto& m : tree_.roots) {
       StateRecord state;
+      const ModuleInfo info = m->info();
+      state.name = info.name;
+      state.type = info.type;
       m->save(state);
-      auto* ms = c.add_modules();
-      ms->set_name(m->info().name);
-      ms->set_type(m->info().type);
-      for (const auto& [name, values] : state.arrays) {
-        auto* f = ms->add_arrays();
-        f->set_name(name);
-        f->mutable_values()->Add(values.begin(), values.end());
-      }
-      for (const auto& [name, v] : state.scalars) (*ms->mutable_scalars())[name] = v;
-      for (const auto& [name, v] : state.integers) (*ms->mutable_integers())[name] = v;
+      encode_state(state, *c.add_modules());
     }
     const auto start = Clock::now();
     write_checkpoint((std::filesystem::path(I.directory) / file).string(), c);
@@ -289,22 +298,18 @@ RunSummary Simulation::run() {
       throw RuntimeError(options_.restart_file +
                          ": checkpoint was written for another scene "
                          "(its modules, resolution or domain differ)");
-    if (static_cast<std::size_t>(c.modules_size()) != modules_.size())
+    const auto& roots = tree_.roots;
+    if (static_cast<std::size_t>(c.modules_size()) != roots.size())
       throw RuntimeError(options_.restart_file + ": checkpoint has " +
                          std::to_string(c.modules_size()) + " modules, the scene " +
-                         std::to_string(modules_.size()));
-    for (std::size_t k = 0; k < modules_.size(); ++k) {
+                         std::to_string(roots.size()));
+    for (std::size_t k = 0; k < roots.size(); ++k) {
       const auto& ms = c.modules(static_cast<int>(k));
-      if (ms.name() != modules_[k]->info().name || ms.type() != modules_[k]->info().type)
+      if (ms.name() != roots[k]->info().name || ms.type() != roots[k]->info().type)
         throw RuntimeError(options_.restart_file + ": checkpoint module '" + ms.name() + "' (" +
-                           ms.type() + ") does not match the scene's '" + modules_[k]->info().name +
+                           ms.type() + ") does not match the scene's '" + roots[k]->info().name +
                            "'");
-      StateRecord state;
-      for (const auto& f : ms.arrays())
-        state.arrays[f.name()].assign(f.values().begin(), f.values().end());
-      for (const auto& [name, v] : ms.scalars()) state.scalars[name] = v;
-      for (const auto& [name, v] : ms.integers()) state.integers[name] = v;
-      modules_[k]->load(state);
+      roots[k]->load(decode_state(ms));
     }
     I.time = c.time();
     I.steps = c.step();
@@ -368,7 +373,8 @@ RunSummary Simulation::run() {
   };
 
   const HealthMonitor health(options_.health ? s.run().health_interval() : 0, s.has_domain());
-  if (health.enabled()) health.check(modules_, I.steps, I.time);
+  const std::vector<const Module*> leaves(tree_.modules.begin(), tree_.modules.end());
+  if (health.enabled()) health.check(leaves, I.steps, I.time);
 
   const auto wall_start = Clock::now();
   const std::clock_t cpu_start = std::clock();
@@ -406,7 +412,7 @@ RunSummary Simulation::run() {
     // Probes do not constrain the step: they sample at the end of the first step that reaches
     // their sampling time (and record that time), so a fine probe interval costs no extra steps.
     double stable = INFINITY;
-    for (const auto& m : modules_) stable = std::min(stable, m->max_dt());
+    for (const auto& m : tree_.roots) stable = std::min(stable, m->max_dt());
     const double remaining = target - I.time;
     if (!(stable > 0.0) || std::isnan(stable))
       throw RuntimeError("time step is " + json_number(stable) + " at t = " + json_number(I.time));
@@ -414,18 +420,14 @@ RunSummary Simulation::run() {
     const double steps_to_target = std::ceil(remaining / stable * (1.0 - 1e-12));
     const double dt = steps_to_target <= 1.0 ? remaining : remaining / steps_to_target;
     const bool reaches_target = steps_to_target <= 1.0;
-    for (std::size_t k = 0; k < modules_.size(); ++k) {
-      const auto start = Clock::now();
-      modules_[k]->advance(dt);
-      I.advance_seconds[k] += seconds_since(start);
-    }
+    for (auto& m : tree_.roots) m->advance(dt);
     I.time = reaches_target ? target : I.time + dt;
     ++I.steps;
-    if (health.due(I.steps)) health.check(modules_, I.steps, I.time);
+    if (health.due(I.steps)) health.check(leaves, I.steps, I.time);
     fire_due(I.time, false);
     progress(false);
   }
-  if (health.enabled()) health.check(modules_, I.steps, I.time);
+  if (health.enabled()) health.check(leaves, I.steps, I.time);
   fire_due(I.time, true);
   if (files && s.checkpoint().at_end()) save_checkpoint("checkpoint_final.ckpt");
   progress(true);
@@ -442,11 +444,20 @@ RunSummary Simulation::run() {
   summary.output_seconds = I.output_seconds;
   summary.peak_memory_bytes = peak_resident_bytes();
   summary.output_directory = I.directory;
-  for (std::size_t k = 0; k < modules_.size(); ++k) {
-    const ModuleInfo info = modules_[k]->info();
-    summary.modules.push_back({info.name, info.type, modules_[k]->particle_count(),
-                               info.active_features, I.advance_seconds[k]});
-    summary.particles += modules_[k]->particle_count();
+  for (const TimedModule* m : tree_.modules) {
+    const ModuleInfo info = m->info();
+    summary.modules.push_back(
+        {info.name, info.type, m->particle_count(), info.active_features, m->advance_seconds()});
+    summary.particles += m->particle_count();
+  }
+  for (const TimedModule* m : tree_.couplers) {
+    const ModuleInfo info = m->info();
+    CouplerTiming timing{info.name, info.type, info.children, info.active_features,
+                         m->advance_seconds(), m->advance_seconds()};
+    const auto& coupler = dynamic_cast<const Coupler&>(m->wrapped());
+    for (std::size_t k = 0; k < coupler.child_count(); ++k)
+      timing.own_seconds -= dynamic_cast<const TimedModule&>(coupler.child(k)).advance_seconds();
+    summary.couplers.push_back(std::move(timing));
   }
   summary.particle_steps_per_second =
       summary.wall_seconds > 0

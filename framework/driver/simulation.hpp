@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "driver/module.hpp"
+#include "driver/module_tree.hpp"
 #include "driver/registry.hpp"
 #include "scene/scene_loader.hpp"
 
@@ -32,6 +33,17 @@ struct ModuleTiming {
   double advance_seconds = 0.0;
 };
 
+// A coupler's time: its whole step, and its own share (exchange and mapping: the step less its
+// children's advance times).
+struct CouplerTiming {
+  std::string name;
+  std::string type;
+  std::vector<std::string> children;
+  std::vector<std::string> features;
+  double advance_seconds = 0.0;
+  double own_seconds = 0.0;
+};
+
 struct RunSummary {
   std::string scene;
   int dimension = 0;
@@ -46,6 +58,7 @@ struct RunSummary {
   std::size_t particles = 0;
   double particle_steps_per_second = 0.0;
   std::vector<ModuleTiming> modules;
+  std::vector<CouplerTiming> couplers;
   std::vector<std::string> outputs;  // what was written: "vtp", "probe:<name>", "checkpoint"
   std::string output_directory;
   std::map<std::string, std::map<std::string, double>> probes;
@@ -62,9 +75,11 @@ class Simulation {
   void initialize();
   RunSummary run();
 
-  // For tests: the modules in scene order.
-  Module& module(std::size_t k) { return *modules_[k]; }
-  std::size_t module_count() const { return modules_.size(); }
+  // For tests: the scene's modules in scene order (coupled or not), and its couplers.
+  Module& module(std::size_t k) { return *tree_.modules[k]; }
+  std::size_t module_count() const { return tree_.modules.size(); }
+  Module& coupler(std::size_t k) { return *tree_.couplers[k]; }
+  std::size_t coupler_count() const { return tree_.couplers.size(); }
   const LoadedScene& scene() const { return scene_; }
 
  private:
@@ -72,7 +87,7 @@ class Simulation {
   LoadedScene scene_;
   const ModuleRegistry& registry_;
   RunOptions options_;
-  std::vector<std::unique_ptr<Module>> modules_;
+  ModuleTree tree_;  // the roots the driver advances, over every module and coupler
   std::unique_ptr<Impl> impl_;
 };
 

@@ -63,6 +63,8 @@ class FluidModule final : public Module {
     ModuleInfo info;
     info.type = "fluid";
     info.name = name_;
+    info.dimension = D;
+    info.spacing = spec_.body().spacing();
     // A coupler fills `contact` with another body's particles (position, velocity, volume and,
     // optionally, acceleration: e.g. a solid's `interface`) and reads back the fluid's force on
     // each of them from `contact_force` (e.g. into the solid's `external_force`).
@@ -126,32 +128,48 @@ class FluidModule final : public Module {
     return spec_.advection_cfl() * dt;
   }
 
-  void advance(double Dt) override {
+  // One advection step, through the same stages a coupler drives (Module::begin_step).
+  void advance(double Dt) override { advance_in_substeps(*this, Dt); }
+
+  // Advection-step work: cell sort, neighbour lists and pair geometry (kept for the acoustic
+  // sub-steps), density, viscous and body forces, transport-velocity shift.
+  void begin_step(double Dt) override {
     if (steps_ > 0 && steps_ % kSortInterval == 0) sort_by_cell();
     build_neighbours();
     if (spec_.density_treatment() != "none") update_density_by_summation();
     update_prior_acceleration();
     if (spec_.transport_velocity()) correct_transport_velocity();
+    step_size_ = Dt;
+    step_done_ = 0.0;
+  }
+
+  // The acoustic step (dt = 0.6 h / (c + |v|max)), cut to what is left of the advection step.
+  double max_substep() const override {
+    if (step_done_ >= step_size_ * (1.0 - 1e-12)) return 0.0;
     const double h = kernel_.smoothing_length();
-    double done = 0.0;
-    while (done < Dt * (1.0 - 1e-12)) {
-      const double dt =
-          std::min(spec_.acoustic_cfl() * h / (sound_speed_ + max_speed()), Dt - done);
-      pressure_relaxation(time_ + done, dt);
-      density_relaxation(time_ + done, dt);
-      done += dt;
-      ++acoustic_steps_;
-    }
-    if (open_.any()) open_.update(fluid_, time_ + Dt);
+    return std::min(spec_.acoustic_cfl() * h / (sound_speed_ + max_speed()),
+                    step_size_ - step_done_);
+  }
+
+  void substep(double dt) override {
+    pressure_relaxation(time_ + step_done_, dt);
+    density_relaxation(time_ + step_done_, dt);
+    step_done_ += dt;
+    ++acoustic_steps_;
+  }
+
+  void end_step() override {
+    if (open_.any()) open_.update(fluid_, time_ + step_size_);
     update_volumes();
-    time_ += Dt;
+    time_ += step_size_;
     ++steps_;
+    step_size_ = step_done_ = 0.0;
   }
 
   double time() const override { return time_; }
 
   void prepare_output() override {
-    if (walls_.particles.has("force")) compute_boundary_force(walls_);
+    if (walls_.particles.has("force")) walls_.particles.vector("force") = recorded_force(walls_);
     if (!fluid_.has("vorticity")) return;
     if constexpr (D == 2) {
       const auto& x = fluid_.vector("position");
@@ -173,12 +191,13 @@ class FluidModule final : public Module {
     }
   }
 
-  // The force of the fluid on each contact particle, from the current state.
+  // The force of the fluid on each contact particle in its last acoustic sub-step (pressure) and
+  // advection step (viscosity), recorded in the fluid's own pair loops: a coupler that applies it
+  // to the contact body over that sub-step balances the impulse exactly.
   void write(const std::string& port, FieldBuffer& out) const override {
     if (port != "contact_force")
       throw RuntimeError("module '" + name_ + "' writes only the port 'contact_force'");
-    std::vector<Vec<D>> force(contact_.particles.size(), Vec<D>::Zero());
-    if (!contact_.empty()) boundary_force(contact_, force);
+    const std::vector<Vec<D>> force = recorded_force(contact_);
     out.points = force.size();
     out.arrays.clear();
     auto& f = out.arrays["force"];
@@ -232,7 +251,12 @@ class FluidModule final : public Module {
         a[i][d] = acceleration ? (*acceleration)[i * D + d] : 0.0;
       }
     }
-    contact_.moves = true;  // its cell list is rebuilt at every advection step
+    const double lattice_volume = std::pow(spec_.body().spacing(), D);
+    contact_.on_fluid_lattice = std::all_of(V.begin(), V.end(), [&](double volume) {
+      return std::abs(volume - lattice_volume) <= 1e-9 * lattice_volume;
+    });
+    contact_.moves = true;    // its cell list is rebuilt at every advection step
+    contact_.records = true;  // a coupler reads the force on it back
     contact_.cells.reset();
   }
 
@@ -391,6 +415,7 @@ class FluidModule final : public Module {
     walls.add_vector("velocity", {.output = true});
     if (has_output("wall_force")) walls.add_vector("force", {.output = true});
     wall_owner_ = owner;
+    walls_.records = has_output("wall_force");
     for (const auto& w : wall_velocity_) walls_.moves = walls_.moves || !w.empty();
     if (walls_.moves) walls.add_vector("acceleration", {.output = true});
     update_wall_motion(0.0, 0.0);
@@ -468,13 +493,19 @@ class FluidModule final : public Module {
       if (!b->cells || b->moves) b->cells.emplace(bx, kernel_.support_radius(), domain_);
       b->list = build_contact_list<D>(x, *b->cells, kernel_.support_radius());
       pair_geometry(x, bx, b->list, b->geometry);
+      if (b->records) {
+        build_pairs_of(*b);
+        b->pair_pressure_force.assign(b->list.pair_count(), Vec<D>::Zero());
+        if (spec_.viscosity() > 0.0)
+          b->pair_viscous_force.assign(b->list.pair_count(), Vec<D>::Zero());
+      }
     }
   }
 
   // The boundary sets that have particles, walls first.
-  std::vector<const BoundarySet<D>*> boundaries() const {
-    std::vector<const BoundarySet<D>*> sets;
-    for (const BoundarySet<D>* b : {&walls_, &contact_})
+  std::vector<BoundarySet<D>*> boundaries() {
+    std::vector<BoundarySet<D>*> sets;
+    for (BoundarySet<D>* b : {&walls_, &contact_})
       if (!b->empty()) sets.push_back(b);
     return sets;
   }
@@ -514,9 +545,16 @@ class FluidModule final : public Module {
           sigma += bV[w] * kernel_.value(domain_.displacement(x[i], bx[w]).norm());
       }
       const double summed = rho0 * sigma / sigma0;
+      if (sees_other_lattice(sets, i)) return;
       rho[i] = free_surface || truncated(i) ? std::max(rho[i], summed) : summed;
     });
     update_pressure();
+  }
+
+  bool sees_other_lattice(const std::vector<BoundarySet<D>*>& sets, std::size_t i) const {
+    for (const BoundarySet<D>* b : sets)
+      if (!b->on_fluid_lattice && b->list.offset[i + 1] > b->list.offset[i]) return true;
+    return false;
   }
 
   void update_pressure() {
@@ -551,14 +589,19 @@ class FluidModule final : public Module {
           if (r <= 0.0) continue;
           sum += (m[j] / rho[j] * kernel_.derivative(r) / r) * (v[i] - v[j]);
         }
-        for (const BoundarySet<D>* b : sets) {
+        for (BoundarySet<D>* b : sets) {
           const auto& bx = b->particles.vector("position");
           const auto& bv = b->particles.vector("velocity");
           const auto& bV = b->particles.scalar("volume");
-          for (Index w : b->list.of(i)) {
+          for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
+            const Index w = b->list.index[k];
             const double r = domain_.displacement(x[i], bx[w]).norm();
             if (r <= 0.0) continue;
             sum += (bV[w] * kernel_.derivative(r) / r) * (2.0 * (v[i] - bv[w]));
+            // Its reaction: m_i a_i = 4 eta V_i V_w dW/r (v_i - v_w), V_i = m_i / rho_i.
+            if (b->records)
+              b->pair_viscous_force[k] = (-4.0 * eta * m[i] / rho[i] * bV[w] *
+                                          kernel_.derivative(r) / r) * (v[i] - bv[w]);
           }
         }
         sum *= 2.0 * eta / rho[i];
@@ -623,58 +666,20 @@ class FluidModule final : public Module {
     }
   };
 
-  std::vector<BoundaryView> boundary_views(const std::vector<const BoundarySet<D>*>& sets) const {
+  std::vector<BoundaryView> boundary_views(const std::vector<BoundarySet<D>*>& sets) const {
     std::vector<BoundaryView> views;
     for (const BoundarySet<D>* b : sets) views.emplace_back(*b, gravity_);
     return views;
   }
 
-  // The force of the fluid on each particle of a boundary set, the reaction to the boundary
-  // terms of the fluid's momentum equation: pressure 2 V_i V_w P* |dW| e_iw and viscosity
-  // 4 eta V_i V_w |dW|/r (v_i - v_w), gathered over the fluid neighbours of each boundary
-  // particle (no atomics; the same sum for any thread count).
-  void boundary_force(const BoundarySet<D>& b, std::vector<Vec<D>>& force) const {
-    const BoundaryView view(b, gravity_);
-    const auto& x = fluid_.vector("position");
-    const auto& v = fluid_.vector("velocity");
-    const auto& rho = fluid_.scalar("density");
-    const auto& p = fluid_.scalar("pressure");
-    const auto& volume = fluid_.scalar("volume");
-    const double eta = spec_.viscosity(), support = kernel_.support_radius();
-    const CellLinkedList<D> cells(x, support, domain_);
-    const RiemannSolver solver = riemann();
-    force.assign(view.x.size(), Vec<D>::Zero());
-    parallel_for_each_index(view.x.size(), [&](std::size_t w) {
-      Vec<D> sum = Vec<D>::Zero();
-      cells.for_each_neighbour(view.x[w], support, Index(-1), [&](Index i) {
-        const Vec<D> d = domain_.displacement(view.x[w], x[i]);  // from fluid i to boundary w
-        const double r = d.norm();
-        if (r <= 0.0 || r >= support) return;
-        const Vec<D> e = d / r;
-        const double g = -kernel_.derivative(r);
-        const auto wall = view.state(Index(w), p[i], rho[i], v[i], d);
-        const double P = solver.pressure(p[i], wall.pressure, v[i].dot(e), wall.velocity.dot(e));
-        sum += (2.0 * volume[i] * view.V[w] * P * g) * e;
-        if (eta > 0.0) sum += (4.0 * eta * volume[i] * view.V[w] * g / r) * (v[i] - view.v[w]);
-      });
-      force[w] = sum;
-    });
-  }
-
-  void compute_boundary_force(BoundarySet<D>& b) {
-    std::vector<Vec<D>> force;
-    boundary_force(b, force);
-    b.particles.vector("force") = std::move(force);
-  }
-
   Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
 
-  // Calls f(e_iw, -dW/dr, V_w, one-sided state of w) for every boundary neighbour w of fluid
+  // Calls f(e_iw, -dW/dr, V_w, one-sided state of w, set, pair) for every boundary neighbour w of fluid
   // particle i (at x, with pressure p, density rho, velocity v), with the pair geometry of the
   // advection step (the two acoustic halves share it).
   template <typename F>
   void for_each_boundary_neighbour(std::size_t i, const Vec<D>& x, double p, double rho,
-                                   const Vec<D>& v, const std::vector<const BoundarySet<D>*>& sets,
+                                   const Vec<D>& v, const std::vector<BoundarySet<D>*>& sets,
                                    const std::vector<BoundaryView>& views, const F& f) const {
     for (std::size_t s = 0; s < sets.size(); ++s) {
       const BoundarySet<D>& b = *sets[s];
@@ -682,7 +687,7 @@ class FluidModule final : public Module {
       for (std::size_t k = b.list.offset[i]; k < b.list.offset[i + 1]; ++k) {
         const Index w = b.list.index[k];
         f(b.geometry.direction[k], b.geometry.gradient[k], view.V[w],
-          view.state(w, p, rho, v, domain_.displacement(view.x[w], x)));
+          view.state(w, p, rho, v, domain_.displacement(view.x[w], x)), *sets[s], k);
       }
     }
   }
@@ -718,10 +723,13 @@ class FluidModule final : public Module {
       }
       for_each_boundary_neighbour(
           i, x[i], p[i], rho[i], v[i], sets, views,
-          [&](const Vec<D>& e, double gradient, double V, const auto& wall) {
+          [&](const Vec<D>& e, double gradient, double V, const auto& wall, BoundarySet<D>& b,
+              std::size_t k) {
             const double P =
                 solver.pressure(p[i], wall.pressure, v[i].dot(e), wall.velocity.dot(e));
             sum -= (V * P * gradient) * e;
+            // Its reaction on the boundary: m_i dv_i = -2 V_i V_w P* |dW| e_iw.
+            if (b.records) b.pair_pressure_force[k] = (2.0 * volume[i] * V * P * gradient) * e;
           });
       dv_[i] = (2.0 / rho[i]) * sum;
     });
@@ -753,7 +761,8 @@ class FluidModule final : public Module {
       }
       for_each_boundary_neighbour(
           i, x[i], p[i], rho[i], v[i], sets, views,
-          [&](const Vec<D>& e, double gradient, double V, const auto& wall) {
+          [&](const Vec<D>& e, double gradient, double V, const auto& wall, BoundarySet<D>&,
+              std::size_t) {
             const double u = v[i].dot(e);
             const double U = solver.velocity(p[i], wall.pressure, u, wall.velocity.dot(e));
             sum += V * (u - U) * gradient;
@@ -782,6 +791,7 @@ class FluidModule final : public Module {
   PairGeometry<D> inner_geometry_;
   std::vector<Vec<D>> dv_, shift_;
   double time_ = 0.0;
+  double step_size_ = 0.0, step_done_ = 0.0;  // the open advection step (staged advance)
   long long steps_ = 0, acoustic_steps_ = 0;
 };
 

@@ -45,7 +45,13 @@ class SolidModule final : public StaticBodyModule<D> {
     ModuleInfo info;
     info.type = "solid";
     info.name = name_;
-    info.writes = {{"interface", {"position", "normal", "volume", "velocity", "acceleration"}}};
+    info.dimension = D;
+    info.spacing = spec_.body().spacing();
+    // `interface`: the surface particles with their current normals; `particles`: every particle,
+    // the point set a fluid's contact sees (it must see all solid particles within its kernel
+    // support: one surface layer under-fills it, and a thin flag is seen from both sides).
+    info.writes = {{"interface", {"position", "normal", "volume", "velocity", "acceleration"}},
+                   {"particles", {"position", "volume", "velocity", "acceleration"}}};
     info.reads = {{"external_force", {"force"}}, {"active_stress", {"active_stress"}}};
     auto& f = info.active_features;
     f.push_back("material " + material_.name());
@@ -183,8 +189,10 @@ class SolidModule final : public StaticBodyModule<D> {
   }
 
   void write(const std::string& port, FieldBuffer& out) const override {
+    if (port == "particles") return write_particles(out);
     if (port != "interface")
-      throw RuntimeError("module '" + name_ + "' writes only the port 'interface'");
+      throw RuntimeError("module '" + name_ + "' has no port '" + port +
+                         "' (it writes 'interface' and 'particles')");
     const Surface<D>& s = surface();
     const auto& x = particles_.vector("position");
     const auto& v = particles_.vector("velocity");
@@ -318,6 +326,17 @@ class SolidModule final : public StaticBodyModule<D> {
 
   static Expression parse(const std::string& text, const std::string& key) {
     return Base::parse_expression(text, kSpaceTime, key);
+  }
+
+  // Every particle's position, reference volume, velocity and acceleration.
+  void write_particles(FieldBuffer& out) const {
+    out.points = particles_.size();
+    out.arrays.clear();
+    out.arrays["volume"] = {1, particles_.scalar("volume")};
+    for (const char* f : {"position", "velocity", "acceleration"}) {
+      const auto raw = particles_.raw(f);
+      out.arrays[f] = {D, std::vector<double>(raw.begin(), raw.end())};
+    }
   }
 
   bool has_frames() const {
