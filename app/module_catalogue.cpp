@@ -2,8 +2,8 @@
 
 #include "active_stress/active_stress_module.hpp"
 #include "diffusion/diffusion_module.hpp"
-#include "fsi/fsi_coupler.hpp"
 #include "fluid_wcsph/fluid_module.hpp"
+#include "fsi/fsi_coupler.hpp"
 #include "monodomain/monodomain_module.hpp"
 #include "solid_tlsph/solid_module.hpp"
 

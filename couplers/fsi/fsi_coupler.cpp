@@ -15,8 +15,8 @@ std::string find_port(const ModuleInfo& info, bool writes, const std::string& po
                       const std::vector<std::string>& fields) {
   std::string found;
   for (const auto& p : writes ? info.writes : info.reads) {
-    const bool named = p.name == port || (p.name.size() > port.size() + 1 &&
-                                          p.name.ends_with("." + port));
+    const bool named =
+        p.name == port || (p.name.size() > port.size() + 1 && p.name.ends_with("." + port));
     if (!named) continue;
     bool complete = true;
     for (const auto& f : fields)
@@ -56,16 +56,15 @@ class FsiCoupler final : public Coupler {
         std::string list;
         for (const auto& f : fields) list += (list.empty() ? "" : ", ") + f;
         throw ConfigError(key + "." + role, "module '" + m.name + "' (" + m.type + ") does not " +
-                                                (writes ? "write" : "read") + " the port '" +
-                                                port + "' (" + list + ") that FSI needs of a " +
-                                                role);
+                                                (writes ? "write" : "read") + " the port '" + port +
+                                                "' (" + list + ") that FSI needs of a " + role);
       }
       return name;
     };
     contact_port_ = need(fluid, "fluid", false, "contact", {"position", "velocity", "volume"});
     force_port_ = need(fluid, "fluid", true, "contact_force", {"force"});
-    particles_port_ = need(solid, "solid", true, "particles",
-                           {"position", "velocity", "acceleration", "volume"});
+    particles_port_ =
+        need(solid, "solid", true, "particles", {"position", "velocity", "acceleration", "volume"});
     external_force_port_ = need(solid, "solid", false, "external_force", {"force"});
     if (fluid.dimension != solid.dimension)
       throw ConfigError(key + ".solid", "module '" + solid.name + "' is " +

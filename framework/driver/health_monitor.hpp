@@ -26,8 +26,7 @@ class HealthMonitor {
   bool enabled() const { return interval_ > 0; }
   // Throws HealthError on the first problem found.
   // Every scene module (the leaves of the coupler tree: their health is their own).
-  void check(const std::vector<const Module*>& modules, unsigned long long step,
-             double time) const;
+  void check(const std::vector<const Module*>& modules, unsigned long long step, double time) const;
 
  private:
   int interval_;

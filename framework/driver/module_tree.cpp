@@ -48,8 +48,7 @@ class Assembly {
     for (int c = 0; c < scene_.couplers_size(); ++c) {
       const auto& spec = scene_.couplers(c);
       const std::string type = coupler_type(spec);
-      if (type.empty())
-        throw ConfigError(coupler_key(c), "a coupler needs its type, e.g. 'fsi:'");
+      if (type.empty()) throw ConfigError(coupler_key(c), "a coupler needs its type, e.g. 'fsi:'");
       if (!registry_.has(type))
         throw ConfigError(coupler_key(c), "no coupler of type '" + type + "'");
       if (auto it = nodes_.find(spec.name()); it != nodes_.end())

@@ -452,8 +452,9 @@ RunSummary Simulation::run() {
   }
   for (const TimedModule* m : tree_.couplers) {
     const ModuleInfo info = m->info();
-    CouplerTiming timing{info.name, info.type, info.children, info.active_features,
-                         m->advance_seconds(), m->advance_seconds()};
+    CouplerTiming timing{
+        info.name,           info.type, info.children, info.active_features, m->advance_seconds(),
+        m->advance_seconds()};
     const auto& coupler = dynamic_cast<const Coupler&>(m->wrapped());
     for (std::size_t k = 0; k < coupler.child_count(); ++k)
       timing.own_seconds -= dynamic_cast<const TimedModule&>(coupler.child(k)).advance_seconds();

@@ -19,7 +19,8 @@ StateRecord decode_state(const proto::ModuleState& in) {
   StateRecord state;
   state.name = in.name();
   state.type = in.type();
-  for (const auto& f : in.arrays()) state.arrays[f.name()].assign(f.values().begin(), f.values().end());
+  for (const auto& f : in.arrays())
+    state.arrays[f.name()].assign(f.values().begin(), f.values().end());
   for (const auto& [name, v] : in.scalars()) state.scalars[name] = v;
   for (const auto& [name, v] : in.integers()) state.integers[name] = v;
   for (const auto& child : in.children()) state.children.push_back(decode_state(child));

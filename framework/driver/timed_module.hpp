@@ -24,12 +24,20 @@ class TimedModule final : public Module {
   ModuleInfo info() const override { return module_->info(); }
   void initialize() override { module_->initialize(); }
   double max_dt() const override { return module_->max_dt(); }
-  void advance(double dt) override { timed([&] { module_->advance(dt); }); }
+  void advance(double dt) override {
+    timed([&] { module_->advance(dt); });
+  }
   double time() const override { return module_->time(); }
-  void begin_step(double Dt) override { timed([&] { module_->begin_step(Dt); }); }
+  void begin_step(double Dt) override {
+    timed([&] { module_->begin_step(Dt); });
+  }
   double max_substep() const override { return module_->max_substep(); }
-  void substep(double dt) override { timed([&] { module_->substep(dt); }); }
-  void end_step() override { timed([&] { module_->end_step(); }); }
+  void substep(double dt) override {
+    timed([&] { module_->substep(dt); });
+  }
+  void end_step() override {
+    timed([&] { module_->end_step(); });
+  }
   void write(const std::string& port, FieldBuffer& out) const override {
     module_->write(port, out);
   }

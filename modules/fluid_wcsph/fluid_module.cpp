@@ -600,8 +600,8 @@ class FluidModule final : public Module {
             sum += (bV[w] * kernel_.derivative(r) / r) * (2.0 * (v[i] - bv[w]));
             // Its reaction: m_i a_i = 4 eta V_i V_w dW/r (v_i - v_w), V_i = m_i / rho_i.
             if (b->records)
-              b->pair_viscous_force[k] = (-4.0 * eta * m[i] / rho[i] * bV[w] *
-                                          kernel_.derivative(r) / r) * (v[i] - bv[w]);
+              b->pair_viscous_force[k] =
+                  (-4.0 * eta * m[i] / rho[i] * bV[w] * kernel_.derivative(r) / r) * (v[i] - bv[w]);
           }
         }
         sum *= 2.0 * eta / rho[i];
@@ -674,9 +674,9 @@ class FluidModule final : public Module {
 
   Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
 
-  // Calls f(e_iw, -dW/dr, V_w, one-sided state of w, set, pair) for every boundary neighbour w of fluid
-  // particle i (at x, with pressure p, density rho, velocity v), with the pair geometry of the
-  // advection step (the two acoustic halves share it).
+  // Calls f(e_iw, -dW/dr, V_w, one-sided state of w, set, pair) for every boundary neighbour w of
+  // fluid particle i (at x, with pressure p, density rho, velocity v), with the pair geometry of
+  // the advection step (the two acoustic halves share it).
   template <typename F>
   void for_each_boundary_neighbour(std::size_t i, const Vec<D>& x, double p, double rho,
                                    const Vec<D>& v, const std::vector<BoundarySet<D>*>& sets,
@@ -721,16 +721,18 @@ class FluidModule final : public Module {
         const double P = solver.pressure(p[i], p[j], v[i].dot(e), v[j].dot(e));
         sum -= (volume[j] * P * inner_geometry_.gradient[k]) * e;
       }
-      for_each_boundary_neighbour(
-          i, x[i], p[i], rho[i], v[i], sets, views,
-          [&](const Vec<D>& e, double gradient, double V, const auto& wall, BoundarySet<D>& b,
-              std::size_t k) {
-            const double P =
-                solver.pressure(p[i], wall.pressure, v[i].dot(e), wall.velocity.dot(e));
-            sum -= (V * P * gradient) * e;
-            // Its reaction on the boundary: m_i dv_i = -2 V_i V_w P* |dW| e_iw.
-            if (b.records) b.pair_pressure_force[k] = (2.0 * volume[i] * V * P * gradient) * e;
-          });
+      for_each_boundary_neighbour(i, x[i], p[i], rho[i], v[i], sets, views,
+                                  [&](const Vec<D>& e, double gradient, double V, const auto& wall,
+                                      BoundarySet<D>& b, std::size_t k) {
+                                    const double P = solver.pressure(
+                                        p[i], wall.pressure, v[i].dot(e), wall.velocity.dot(e));
+                                    sum -= (V * P * gradient) * e;
+                                    // Its reaction on the boundary: m_i dv_i = -2 V_i V_w P* |dW|
+                                    // e_iw.
+                                    if (b.records)
+                                      b.pair_pressure_force[k] =
+                                          (2.0 * volume[i] * V * P * gradient) * e;
+                                  });
       dv_[i] = (2.0 / rho[i]) * sum;
     });
     parallel_for_each_index(x.size(), [&](std::size_t i) { v[i] += dt * (dv_[i] + prior[i]); });
@@ -759,14 +761,14 @@ class FluidModule final : public Module {
         const double U = solver.velocity(p[i], p[j], u, v[j].dot(e));
         sum += volume[j] * (u - U) * inner_geometry_.gradient[k];
       }
-      for_each_boundary_neighbour(
-          i, x[i], p[i], rho[i], v[i], sets, views,
-          [&](const Vec<D>& e, double gradient, double V, const auto& wall, BoundarySet<D>&,
-              std::size_t) {
-            const double u = v[i].dot(e);
-            const double U = solver.velocity(p[i], wall.pressure, u, wall.velocity.dot(e));
-            sum += V * (u - U) * gradient;
-          });
+      for_each_boundary_neighbour(i, x[i], p[i], rho[i], v[i], sets, views,
+                                  [&](const Vec<D>& e, double gradient, double V, const auto& wall,
+                                      BoundarySet<D>&, std::size_t) {
+                                    const double u = v[i].dot(e);
+                                    const double U = solver.velocity(p[i], wall.pressure, u,
+                                                                     wall.velocity.dot(e));
+                                    sum += V * (u - U) * gradient;
+                                  });
       drho[i] = 2.0 * rho[i] * sum;
     });
     parallel_for_each_index(x.size(), [&](std::size_t i) { rho[i] += 0.5 * dt * drho[i]; });
