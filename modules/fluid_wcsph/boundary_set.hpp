@@ -38,13 +38,6 @@ struct BoundarySet {
   // very Riemann pressures the fluid used in it, and the viscous force of the advection step. The
   // impulse the fluid receives is then exactly opposite to what the boundary receives.
   bool records = false;
-  // Whether its particles sit on the fluid's own lattice (volume dp^D, as walls do). A body of
-  // another resolution does not: the kernel sum over a finer lattice next to the fluid's exceeds
-  // the fluid's reference number density (by 0.76% and 0.71% in the first two fluid rows beside a
-  // gate of four rows at a quarter of the fluid's spacing, 1.6% at half), and with c = 20 sqrt(gH)
-  // that excess is about three times the hydrostatic pressure: the fluid particles that see such a
-  // body keep the density of the continuity equation instead of the summed one.
-  bool on_fluid_lattice = true;
   std::vector<Vec<D>> pair_pressure_force, pair_viscous_force;
   NeighbourList pairs_of;  // boundary particle -> indices of its pairs in `list`
 

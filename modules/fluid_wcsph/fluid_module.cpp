@@ -251,10 +251,6 @@ class FluidModule final : public Module {
         a[i][d] = acceleration ? (*acceleration)[i * D + d] : 0.0;
       }
     }
-    const double lattice_volume = std::pow(spec_.body().spacing(), D);
-    contact_.on_fluid_lattice = std::all_of(V.begin(), V.end(), [&](double volume) {
-      return std::abs(volume - lattice_volume) <= 1e-9 * lattice_volume;
-    });
     contact_.moves = true;    // its cell list is rebuilt at every advection step
     contact_.records = true;  // a coupler reads the force on it back
     contact_.cells.reset();
@@ -545,16 +541,9 @@ class FluidModule final : public Module {
           sigma += bV[w] * kernel_.value(domain_.displacement(x[i], bx[w]).norm());
       }
       const double summed = rho0 * sigma / sigma0;
-      if (sees_other_lattice(sets, i)) return;
       rho[i] = free_surface || truncated(i) ? std::max(rho[i], summed) : summed;
     });
     update_pressure();
-  }
-
-  bool sees_other_lattice(const std::vector<BoundarySet<D>*>& sets, std::size_t i) const {
-    for (const BoundarySet<D>* b : sets)
-      if (!b->on_fluid_lattice && b->list.offset[i + 1] > b->list.offset[i]) return true;
-    return false;
   }
 
   void update_pressure() {

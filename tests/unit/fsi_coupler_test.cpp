@@ -83,8 +83,8 @@ TEST(FsiCoupler, ImpulseOnTheSolidBalancesTheFluidsToRoundOff) {
             << block_momentum << " (scale " << scale << ")\n";
   // The water has hit the block: it carries a good part of the momentum now.
   EXPECT_GT(block_momentum, 0.02 * before[0]);
-  // Measured: a change of 1.4e-13 against a scale of 91 (1.6e-15 relative).
-  EXPECT_LT((after - before).norm(), 3e-15 * scale);
+  // Measured: a change of 2.3e-13 against a scale of 91 (2.5e-15 relative).
+  EXPECT_LT((after - before).norm(), 4e-15 * scale);
 }
 
 // Forwards every call to the solid, adding up the work of the external force it is given over
