@@ -105,7 +105,7 @@ class FsiCoupler final : public Coupler {
   std::vector<std::string> features() const override {
     std::vector<std::string> f;
     f.push_back("fluid '" + child(0).info().name + "' sees solid '" + child(1).info().name +
-                "' as a contact body (one-sided Riemann, averaged velocity and acceleration)");
+                "' as a contact body (one-sided Riemann, velocity averaged over its sub-steps)");
     std::ostringstream sub;
     sub << "solid sub-stepping (kappa = floor(dt_acoustic / dt_solid) + 1";
     if (acoustic_steps_ > 0) sub << ", mean " << double(solid_substeps_) / double(acoustic_steps_);

@@ -30,6 +30,7 @@ class Assembly {
       pool_.push_back(std::move(timed));
     }
     tree_.couplers.assign(scene.couplers_size(), nullptr);
+    tree_.children.resize(scene.couplers_size());
   }
 
   ModuleTree build() {
@@ -100,7 +101,11 @@ class Assembly {
     std::vector<std::unique_ptr<Module>> children;
     for (const auto& name : coupled_names(spec, registry_.roles(type))) {
       const Node& node = nodes_.at(name);
-      children.push_back(node.coupler ? build_coupler(node.index) : std::move(pool_[node.index]));
+      std::unique_ptr<Module> child =
+          node.coupler ? build_coupler(node.index) : std::move(pool_[node.index]);
+      tree_.children[c].push_back(node.coupler ? tree_.couplers[node.index]
+                                               : tree_.modules[node.index]);
+      children.push_back(std::move(child));
     }
     auto coupler = std::make_unique<TimedModule>(
         registry_.create(type, spec, std::move(children), {&scene_, coupler_key(c)}));

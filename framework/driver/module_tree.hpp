@@ -13,9 +13,10 @@
 namespace cosph {
 
 struct ModuleTree {
-  std::vector<std::unique_ptr<Module>> roots;  // what the driver advances, in scene order
-  std::vector<TimedModule*> modules;           // every scene module, in the order of `modules`
-  std::vector<TimedModule*> couplers;          // every coupler, in the order of `couplers`
+  std::vector<std::unique_ptr<Module>> roots;       // what the driver advances, in scene order
+  std::vector<TimedModule*> modules;                // every scene module, in the order of `modules`
+  std::vector<TimedModule*> couplers;               // every coupler, in the order of `couplers`
+  std::vector<std::vector<TimedModule*>> children;  // of each coupler, in its roles' order
 };
 
 // Takes the scene's initialised modules (in scene order) and builds its couplers over them.

@@ -450,14 +450,13 @@ RunSummary Simulation::run() {
         {info.name, info.type, m->particle_count(), info.active_features, m->advance_seconds()});
     summary.particles += m->particle_count();
   }
-  for (const TimedModule* m : tree_.couplers) {
+  for (std::size_t c = 0; c < tree_.couplers.size(); ++c) {
+    const TimedModule* m = tree_.couplers[c];
     const ModuleInfo info = m->info();
-    CouplerTiming timing{
-        info.name,           info.type, info.children, info.active_features, m->advance_seconds(),
-        m->advance_seconds()};
-    const auto& coupler = dynamic_cast<const Coupler&>(m->wrapped());
-    for (std::size_t k = 0; k < coupler.child_count(); ++k)
-      timing.own_seconds -= dynamic_cast<const TimedModule&>(coupler.child(k)).advance_seconds();
+    CouplerTiming timing{info.name, info.type, info.children, info.active_features};
+    timing.advance_seconds = timing.own_seconds = m->advance_seconds();
+    for (const TimedModule* child : tree_.children[c])
+      timing.own_seconds -= child->advance_seconds();
     summary.couplers.push_back(std::move(timing));
   }
   summary.particle_steps_per_second =

@@ -92,6 +92,7 @@ class SolidModule final : public StaticBodyModule<D> {
       if (o == "fibre_strain") particles_.add_vector("fibre_strain", {.output = true});
       if (o == "stress") particles_.add_matrix("stress", {.output = true});
       if (o == "hourglass") particles_.add_scalar("hourglass", {.output = true});
+      if (o == "external_force") particles_.add_vector("external_force", {.output = true});
     }
     // T_a per particle: prescribed here, or added when a coupler first writes the port.
     if (spec_.has_active_tension())
@@ -234,6 +235,7 @@ class SolidModule final : public StaticBodyModule<D> {
         const std::size_t i = in.points == n ? k : surface().particles[k];
         for (int c = 0; c < D; ++c) external_force_[i][c] = it->second.values[k * D + c];
       }
+      if (particles_.has("external_force")) particles_.vector("external_force") = external_force_;
       return;
     }
     if (port == "active_stress") {
