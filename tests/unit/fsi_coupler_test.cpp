@@ -13,6 +13,7 @@
 #include "../support/simulation_setup.hpp"
 #include "core/error.hpp"
 #include "driver/coupler_registry.hpp"
+#include "driver/state_codec.hpp"
 #include "driver/timed_module.hpp"
 #include "scene/scene_loader.hpp"
 
@@ -302,6 +303,91 @@ TEST(FsiCoupler, ASceneWithoutCouplersBuildsNone) {
   options.progress = false;
   auto run = make_simulation(text, {}, options);
   EXPECT_TRUE(run->run().couplers.empty());
+}
+
+}  // namespace
+}  // namespace cosph
+
+namespace cosph {
+namespace {
+
+// A coupler that owns one module and only forwards (what an electromechanics coupler is to the
+// FSI coupler that owns it): its ports are the child's, named "child.port".
+class Wrapper final : public Coupler {
+ public:
+  explicit Wrapper(std::unique_ptr<Module> child)
+      : Coupler("wrapper", "wrapped", [&] {
+          std::vector<std::unique_ptr<Module>> c;
+          c.push_back(std::move(child));
+          return c;
+        }()) {}
+  double max_dt() const override { return child(0).max_dt(); }
+  void advance(double dt) override {
+    child(0).advance(dt);
+    ++steps_;
+  }
+
+ protected:
+  std::vector<std::string> features() const override { return {"forwards"}; }
+  void connect() override {}
+  void save_own(StateRecord& state) const override { state.integers["steps"] = steps_; }
+  void load_own(const StateRecord& state) override { steps_ = state.integers.at("steps"); }
+
+ private:
+  long long steps_ = 0;
+};
+
+std::unique_ptr<Coupler> collision(bool wrap_the_solid, const LoadedScene& scene) {
+  std::vector<std::unique_ptr<Module>> children;
+  for (int k = 0; k < 2; ++k) {
+    const ModuleContext context{&scene.scene, "modules[" + std::to_string(k) + "]", "."};
+    auto m = builtin_modules().create(k == 0 ? "fluid" : "solid", scene.scene.modules(k), context);
+    m->initialize();
+    children.push_back(std::move(m));
+  }
+  if (wrap_the_solid) children[1] = std::make_unique<Wrapper>(std::move(children[1]));
+  auto fsi =
+      make_fsi_coupler(scene.scene.couplers(0), std::move(children), {&scene.scene, "couplers[0]"});
+  fsi->initialize();
+  return fsi;
+}
+
+std::vector<double> solid_positions(Coupler& fsi) {
+  FieldBuffer out;
+  fsi.write(fsi.info().writes.back().name, out);  // the solid's particles, however nested
+  return out.arrays.at("position").values;
+}
+
+TEST(FsiCoupler, ASolidInsideAnotherCouplerIsCoupledTheSameAndItsStateNests) {
+  const LoadedScene scene = load_scene_text(kCollision, "collision.yaml");
+  auto plain = collision(false, scene), nested = collision(true, scene);
+  EXPECT_EQ(nested->info().writes.back().name, "wrapped.block.particles");
+  for (int step = 0; step < 30; ++step) {
+    plain->advance(plain->max_dt());
+    nested->advance(nested->max_dt());
+  }
+  ASSERT_EQ(solid_positions(*plain), solid_positions(*nested));
+
+  // Save two levels deep, through the checkpoint message, into a fresh tree; continue both.
+  StateRecord state;
+  nested->save(state);
+  ASSERT_EQ(state.children.size(), 2u);
+  EXPECT_EQ(state.children[1].name, "wrapped");
+  ASSERT_EQ(state.children[1].children.size(), 1u);
+  EXPECT_EQ(state.children[1].children[0].name, "block");
+  // The wrapper counted the solid's sub-steps, as the FSI coupler did.
+  EXPECT_EQ(state.children[1].integers.at("steps"), state.integers.at("solid_substeps"));
+  EXPECT_GT(state.integers.at("solid_substeps"), 30);
+  proto::ModuleState message;
+  encode_state(state, message);
+  auto restored = collision(true, scene);
+  restored->load(decode_state(message));
+  for (int step = 0; step < 30; ++step) {
+    nested->advance(nested->max_dt());
+    restored->advance(restored->max_dt());
+  }
+  EXPECT_EQ(solid_positions(*nested), solid_positions(*restored));
+  EXPECT_NE(solid_positions(*nested), solid_positions(*plain));  // it moved on from there
 }
 
 }  // namespace
