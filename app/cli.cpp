@@ -137,7 +137,12 @@ int run_cli(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     for (const auto& m : summary.modules) {
       out << "module " << m.name << " (" << m.type << "):";
       for (const auto& f : m.features) out << " [" << f << "]";
-      out << "\n";
+      out << "  advance " << m.advance_seconds << " s\n";
+    }
+    for (const auto& c : summary.couplers) {
+      out << "coupler " << c.name << " (" << c.type << "):";
+      for (const auto& f : c.features) out << " [" << f << "]";
+      out << "  own " << c.own_seconds << " s of " << c.advance_seconds << " s\n";
     }
     if (!a.options.bench) {
       out << "output: " << summary.output_directory << "/ (summary.json";

@@ -232,6 +232,12 @@ class FluidModule final : public Module {
         throw RuntimeError("module '" + name_ + "': port 'contact': volume of point " +
                            std::to_string(i) + " is not positive");
     auto& c = contact_.particles;
+    // Inside an advection step the pair lists of the step index the contact set: it may move,
+    // not change its size.
+    if (step_size_ > 0.0 && n != c.size())
+      throw RuntimeError("module '" + name_ + "': port 'contact': " + std::to_string(n) +
+                         " points inside an advection step that began with " +
+                         std::to_string(c.size()));
     if (!c.has("position")) {
       c.add_vector("position", {.output = true});
       c.add_vector("velocity", {.output = true});
