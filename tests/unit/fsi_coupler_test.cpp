@@ -67,6 +67,19 @@ std::pair<Vec<2>, double> momentum(Simulation& s) {
   return {total, scale};
 }
 
+// The collision scene's fluid and solid, built and initialised outside a Simulation (for tests
+// that compose the coupler themselves).
+std::vector<std::unique_ptr<Module>> collision_modules(const LoadedScene& scene) {
+  std::vector<std::unique_ptr<Module>> modules;
+  for (int k = 0; k < 2; ++k) {
+    const ModuleContext context{&scene.scene, "modules[" + std::to_string(k) + "]", "."};
+    auto m = builtin_modules().create(k == 0 ? "fluid" : "solid", scene.scene.modules(k), context);
+    m->initialize();
+    modules.push_back(std::move(m));
+  }
+  return modules;
+}
+
 TEST(FsiCoupler, ImpulseOnTheSolidBalancesTheFluidsToRoundOff) {
   auto s = make_simulation(kCollision);
   const auto [before, scale] = momentum(*s);
@@ -139,13 +152,7 @@ double solid_energy(Module& solid) {
 
 TEST(FsiCoupler, WorkOfTheFluidForceIsTheSolidsEnergyChange) {
   const LoadedScene scene = load_scene_text(kCollision, "collision.yaml");
-  std::vector<std::unique_ptr<Module>> children;
-  for (int k = 0; k < 2; ++k) {
-    const ModuleContext context{&scene.scene, "modules[" + std::to_string(k) + "]", "."};
-    auto m = builtin_modules().create(k == 0 ? "fluid" : "solid", scene.scene.modules(k), context);
-    m->initialize();
-    children.push_back(std::move(m));
-  }
+  std::vector<std::unique_ptr<Module>> children = collision_modules(scene);
   auto meter_owned = std::make_unique<WorkMeter>(std::move(children[1]));
   WorkMeter* meter = meter_owned.get();
   children[1] = std::move(meter_owned);
@@ -338,13 +345,7 @@ class Wrapper final : public Coupler {
 };
 
 std::unique_ptr<Coupler> collision(bool wrap_the_solid, const LoadedScene& scene) {
-  std::vector<std::unique_ptr<Module>> children;
-  for (int k = 0; k < 2; ++k) {
-    const ModuleContext context{&scene.scene, "modules[" + std::to_string(k) + "]", "."};
-    auto m = builtin_modules().create(k == 0 ? "fluid" : "solid", scene.scene.modules(k), context);
-    m->initialize();
-    children.push_back(std::move(m));
-  }
+  std::vector<std::unique_ptr<Module>> children = collision_modules(scene);
   if (wrap_the_solid) children[1] = std::make_unique<Wrapper>(std::move(children[1]));
   auto fsi =
       make_fsi_coupler(scene.scene.couplers(0), std::move(children), {&scene.scene, "couplers[0]"});
