@@ -89,7 +89,11 @@ class FsiCoupler final : public Coupler {
       fluid().substep(dt);
       fluid().write(force_port_, force_);
       solid().read(external_force_port_, force_);
-      const long long kappa = static_cast<long long>(std::floor(dt / solid().max_dt())) + 1;
+      const double solid_dt = solid().max_dt();
+      if (!(solid_dt > 0.0) || !std::isfinite(solid_dt))
+        throw RuntimeError("FSI coupler: the solid's stable step is " + std::to_string(solid_dt) +
+                           " at t = " + std::to_string(fluid().time()));
+      const long long kappa = static_cast<long long>(std::floor(dt / solid_dt)) + 1;
       for (long long k = 0; k < kappa; ++k) solid().advance(dt / double(kappa));
       solid().write(particles_port_, after_);
       average(dt);
