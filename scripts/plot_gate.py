@@ -27,7 +27,7 @@ def main(csv_path: str, png_path: str) -> None:
     ax.set_xlabel("t (s)")
     ax.set_ylabel("free-end displacement (mm)")
     ax.set_title("Dam break through an elastic gate (Antoci et al. 2007)")
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="center right", fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(png_path, dpi=120)
