@@ -72,8 +72,9 @@ class FluidModule final : public Module {
     info.writes = {{"contact_force", {"force"}}};
     auto& f = info.active_features;
     f.push_back("weakly-compressible SPH, kernel " + kernel_name(kernel_.type()));
-    f.push_back(spec_.riemann_solver() == "acoustic" ? "acoustic Riemann solver"
-                                                     : "low-dissipation Riemann solver");
+    f.push_back(spec_.riemann_solver() == "acoustic"          ? "acoustic Riemann solver"
+                : spec_.riemann_solver() == "continuity_only" ? "Riemann solver, continuity only"
+                                                              : "low-dissipation Riemann solver");
     f.push_back("density " + spec_.density_treatment());
     f.push_back("dual-criteria time stepping");
     if (spec_.viscosity() > 0.0) f.push_back("viscosity");
@@ -374,8 +375,11 @@ class FluidModule final : public Module {
   }
 
   RiemannSolver riemann() const {
+    const std::string& kind = spec_.riemann_solver();
     return {spec_.density() * sound_speed_, sound_speed_,
-            spec_.riemann_solver() == "low_dissipation"};
+            kind == "acoustic"          ? MomentumDissipation::acoustic
+            : kind == "continuity_only" ? MomentumDissipation::none
+                                        : MomentumDissipation::limited};
   }
 
   void sort_by_cell() {

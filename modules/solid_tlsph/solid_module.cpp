@@ -57,6 +57,9 @@ class SolidModule final : public StaticBodyModule<D> {
     f.push_back("material " + material_.name());
     f.push_back("total-Lagrangian SPH, kernel " + kernel_name(kernel_.type()) +
                 ", corrected gradients");
+    if (spec_.gradient_correction() == "quadratic")
+      f.push_back("quadratic gradient correction (" + std::to_string(pairs_.quadratic_particles) +
+                  " of " + std::to_string(X_.size()) + " particles)");
     f.push_back(spec_.integrator() == "rk4" ? "RK4 integrator" : "position Verlet integrator");
     if (spec_.has_artificial_viscosity()) f.push_back("artificial viscosity");
     if (spec_.has_hourglass_control()) f.push_back("hourglass control");
@@ -105,14 +108,18 @@ class SolidModule final : public StaticBodyModule<D> {
                                       Base::scene_directory_);
     }
     try {
-      pairs_ = build_reference_pairs<D>(X_, volume, kernel_, spec_.has_hourglass_control());
+      pairs_ = build_reference_pairs<D>(X_, volume, kernel_,
+                                        spec_.gradient_correction() == "quadratic"
+                                            ? GradientCorrection::quadratic
+                                            : GradientCorrection::linear,
+                                        spec_.has_hourglass_control());
     } catch (const RuntimeError& e) {
       throw RuntimeError("module '" + name_ + "': " + e.what());
     }
     F_.assign(n, Mat<D>::Identity());
-    T_.assign(n, Mat<D>::Zero());
+    P_.assign(n, Mat<D>::Zero());
     if (spec_.has_artificial_viscosity()) {
-      G_.assign(n, Mat<D>::Zero());
+      A_.assign(n, Mat<D>::Zero());
       density_.assign(n, material_.density());
     }
     x_ = X_;
@@ -520,11 +527,11 @@ class SolidModule final : public StaticBodyModule<D> {
     parallel_for_each_index(n, [&](std::size_t i) {
       const Mat<D>& F = F_[i];
       const Mat<D> frame = frames_.empty() ? Mat<D>::Identity() : frames_[i];
-      T_[i] = first_piola(i, F, frame) * pairs_.correction[i].transpose();
+      P_[i] = first_piola(i, F, frame);
       x_[i] = X_[i] + u[i];
       if (viscosity) {
         const double J = F.determinant();
-        G_[i] = J * F.inverse().transpose() * pairs_.correction[i].transpose();
+        A_[i] = J * F.inverse().transpose();
         density_[i] = material_.density() / J;
       }
     });
@@ -535,8 +542,8 @@ class SolidModule final : public StaticBodyModule<D> {
                                       kernel_.smoothing_length()};
     const double stiffness = spec_.hourglass_control().coefficient() * material_.young_modulus();
     parallel_for_each_index(n, [&](std::size_t i) {
-      Vec<D> force = pair_stress_divergence<D>(pairs_, T_, i);
-      if (viscosity) force += artificial_viscosity<D>(pairs_, x_, v, density_, G_, viscous, i);
+      Vec<D> force = pair_stress_divergence<D>(pairs_, P_, i);
+      if (viscosity) force += artificial_viscosity<D>(pairs_, x_, v, density_, A_, viscous, i);
       if (hourglass) force += hourglass_force<D>(pairs_, X_, x_, F_, stiffness, i);
       a[i] = force / rho0 + gravity;
     });
@@ -669,7 +676,7 @@ class SolidModule final : public StaticBodyModule<D> {
   Expression active_tension_;
   std::vector<Expression> initial_velocity_;
   std::vector<Vec<D>> X_, x_;
-  std::vector<Mat<D>> frames_, F_, T_, G_;
+  std::vector<Mat<D>> frames_, F_, P_, A_;  // P: first Piola; A = J F^-T (viscosity)
   std::vector<double> density_;
   const std::vector<double>* active_ = nullptr;  // T_a per particle, when there is one
   ReferencePairs<D> pairs_;

@@ -1,37 +1,112 @@
 #include "solid_tlsph/tlsph_operators.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <string>
+
+#include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "kernels/kernel_correction.hpp"
 #include "neighbour/cell_linked_list.hpp"
 
 namespace cosph {
 
+namespace {
+
+// The quadratic correction at one particle: g_ij = omega_ij [I 0] M^-1 p(s_ij) / h with the
+// scaled offsets s = X_ij / h, the basis p(s) = (s, s_a s_b for a <= b) and the moment matrix
+// M = sum_j omega_ij p p^T. Returns false (and leaves g alone) when M cannot be inverted
+// reliably: then the linear correction stays.
+template <int D>
+bool quadratic_gradients(const std::vector<Vec<D>>& X, const NeighbourList& nl,
+                         const std::vector<double>& omega, double h, std::size_t i,
+                         std::vector<Vec<D>>& g) {
+  constexpr int m = D + D * (D + 1) / 2;
+  using Basis = Eigen::Matrix<double, m, 1>;
+  auto basis = [&](const Vec<D>& X_ij) {
+    const Vec<D> s = X_ij / h;
+    Basis p;
+    int row = D;
+    for (int a = 0; a < D; ++a) {
+      p[a] = s[a];
+      for (int b = a; b < D; ++b) p[row++] = s[a] * s[b];
+    }
+    return p;
+  };
+  Eigen::Matrix<double, m, m> M = Eigen::Matrix<double, m, m>::Zero();
+  for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
+    const Basis p = basis(X[nl.index[k]] - X[i]);
+    M.noalias() += omega[k] * p * p.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, m, m>> eigen(M);
+  const auto& lambda = eigen.eigenvalues();  // ascending
+  // A neighbourhood that spans fewer than three layers along some direction makes M singular
+  // (its quadratic in that direction equals its linear term); nearly so, the fit would amplify
+  // round-off into the stresses.
+  if (!(lambda[0] > 1e-6 * lambda[m - 1])) return false;
+  const Eigen::Matrix<double, m, m> inverse =
+      eigen.eigenvectors() * lambda.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
+  for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
+    const Basis c = inverse * basis(X[nl.index[k]] - X[i]);
+    g[k] = (omega[k] / h) * c.template head<D>();
+  }
+  return true;
+}
+
+// b_ij = -(V_j / V_i) g_ji, found through the reverse pair (reference neighbour lists are
+// symmetric: j sees i whenever i sees j).
+template <int D>
+void reverse_gradients(const NeighbourList& nl, const std::vector<double>& volume,
+                       ReferencePairs<D>& pairs) {
+  pairs.reverse.resize(nl.pair_count());
+  parallel_for_each_index(volume.size(), [&](std::size_t i) {
+    for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
+      const Index j = nl.index[k];
+      std::size_t back = nl.offset[j];
+      while (back < nl.offset[j + 1] && nl.index[back] != Index(i)) ++back;
+      if (back == nl.offset[j + 1])
+        throw RuntimeError("reference neighbour list is not symmetric at particle " +
+                           std::to_string(i));
+      pairs.reverse[k] = -(volume[j] / volume[i]) * pairs.gradient[back];
+    }
+  });
+}
+
+}  // namespace
+
 template <int D>
 ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
                                         const std::vector<double>& volume, const Kernel& kernel,
-                                        bool hourglass) {
+                                        GradientCorrection correction, bool hourglass) {
   ReferencePairs<D> pairs;
   const Domain<D> free_space;  // a solid body is never periodic
   pairs.neighbours = build_inner_list<D>(X, kernel.support_radius(), free_space);
-  compute_correction_matrices<D>(X, volume, pairs.neighbours, kernel, free_space, pairs.correction);
+  std::vector<Mat<D>> B;
+  compute_correction_matrices<D>(X, volume, pairs.neighbours, kernel, free_space, B);
   const auto& nl = pairs.neighbours;
-  pairs.weighted_gradient.resize(nl.pair_count());
+  const double h = kernel.smoothing_length();
+  pairs.gradient.resize(nl.pair_count());
   pairs.gradient_sum.resize(X.size());
+  std::vector<double> omega(nl.pair_count());
   if (hourglass) pairs.hourglass_weight.resize(nl.pair_count());
+  std::vector<char> quadratic(X.size(), 0);
   parallel_for_each_index(X.size(), [&](std::size_t i) {
-    Vec<D> sum = Vec<D>::Zero();
     for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
       const Index j = nl.index[k];
-      const Vec<D> r = X[i] - X[j];
-      const double distance = r.norm();
-      const Vec<D> w = volume[j] * kernel.derivative(distance) / distance * r;
-      pairs.weighted_gradient[k] = w;
-      sum += w;
+      const double distance = (X[i] - X[j]).norm();
+      // w_ij = V_j W'(r) (X_i - X_j) / r = omega_ij X_ij with omega_ij = -V_j W'(r) / r >= 0.
+      omega[k] = -volume[j] * kernel.derivative(distance) / distance;
+      pairs.gradient[k] = B[i].transpose() * (omega[k] * (X[j] - X[i]));
       if (hourglass)
         pairs.hourglass_weight[k] = volume[j] * kernel.value(distance) / (distance * distance);
     }
+    if (correction == GradientCorrection::quadratic)
+      quadratic[i] = quadratic_gradients<D>(X, nl, omega, h, i, pairs.gradient);
+    Vec<D> sum = Vec<D>::Zero();
+    for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) sum += pairs.gradient[k];
     pairs.gradient_sum[i] = sum;
   });
+  for (char q : quadratic) pairs.quadratic_particles += q;
+  reverse_gradients<D>(nl, volume, pairs);
   return pairs;
 }
 
@@ -42,15 +117,15 @@ void deformation_gradients(const ReferencePairs<D>& pairs, const std::vector<Vec
   parallel_for_each_index(u.size(), [&](std::size_t i) {
     Mat<D> G = Mat<D>::Zero();
     for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k)
-      G.noalias() += (u[nl.index[k]] - u[i]) * pairs.weighted_gradient[k].transpose();
-    F[i] = Mat<D>::Identity() + G * pairs.correction[i];
+      G.noalias() += (u[nl.index[k]] - u[i]) * pairs.gradient[k].transpose();
+    F[i] = Mat<D>::Identity() + G;
   });
 }
 
 template <int D>
 Vec<D> artificial_viscosity(const ReferencePairs<D>& pairs, const std::vector<Vec<D>>& x,
                             const std::vector<Vec<D>>& v, const std::vector<double>& density,
-                            const std::vector<Mat<D>>& G, const ViscosityParameters& p,
+                            const std::vector<Mat<D>>& A, const ViscosityParameters& p,
                             std::size_t i) {
   const auto& nl = pairs.neighbours;
   const double h = p.smoothing_length;
@@ -62,7 +137,7 @@ Vec<D> artificial_viscosity(const ReferencePairs<D>& pairs, const std::vector<Ve
     if (phi >= 0.0) continue;
     const double q =
         0.25 * (density[i] + density[j]) * (-p.alpha * p.sound_speed * phi + p.beta * phi * phi);
-    sum.noalias() -= q * ((G[i] + G[j]) * pairs.weighted_gradient[k]);
+    sum.noalias() -= q * (A[i] * pairs.gradient[k] + A[j] * pairs.reverse[k]);
   }
   return sum;
 }
@@ -89,8 +164,9 @@ Vec<D> hourglass_force(const ReferencePairs<D>& pairs, const std::vector<Vec<D>>
 }
 
 #define COSPH_INSTANTIATE_TLSPH(D)                                                                \
-  template ReferencePairs<D> build_reference_pairs<D>(                                            \
-      const std::vector<Vec<D>>&, const std::vector<double>&, const Kernel&, bool);               \
+  template ReferencePairs<D> build_reference_pairs<D>(const std::vector<Vec<D>>&,                 \
+                                                      const std::vector<double>&, const Kernel&,  \
+                                                      GradientCorrection, bool);                  \
   template void deformation_gradients<D>(const ReferencePairs<D>&, const std::vector<Vec<D>>&,    \
                                          std::vector<Mat<D>>&);                                   \
   template Vec<D> artificial_viscosity<D>(const ReferencePairs<D>&, const std::vector<Vec<D>>&,   \

@@ -19,15 +19,17 @@ namespace cosph {
 namespace {
 
 TEST(Riemann, EqualStatesGiveThemselves) {
-  for (bool limited : {false, true}) {
-    const RiemannSolver s{1000.0 * 20.0, 20.0, limited};
+  for (auto momentum :
+       {MomentumDissipation::acoustic, MomentumDissipation::limited, MomentumDissipation::none}) {
+    const RiemannSolver s{1000.0 * 20.0, 20.0, momentum};
     EXPECT_DOUBLE_EQ(s.pressure(5.0, 5.0, 0.3, 0.3), 5.0);
     EXPECT_DOUBLE_EQ(s.velocity(5.0, 5.0, 0.3, 0.3), 0.3);
   }
 }
 
 TEST(Riemann, DissipationActsOnApproachOnlyWhenLimited) {
-  const RiemannSolver acoustic{1000.0 * 20.0, 20.0, false}, limited{1000.0 * 20.0, 20.0, true};
+  const RiemannSolver acoustic{1000.0 * 20.0, 20.0, MomentumDissipation::acoustic},
+      limited{1000.0 * 20.0, 20.0, MomentumDissipation::limited};
   // Approaching pair (u_L > u_R): both raise P* above the mean pressure; the acoustic solver by
   // Z (u_L - u_R) / 2 exactly.
   EXPECT_DOUBLE_EQ(acoustic.pressure(0.0, 0.0, 1.0, -1.0), 20000.0 * 2.0 / 2.0);
@@ -43,6 +45,17 @@ TEST(Riemann, DissipationActsOnApproachOnlyWhenLimited) {
   // Symmetry: swapping the sides (and the direction) gives the same P* and the opposite U*.
   EXPECT_DOUBLE_EQ(limited.pressure(3.0, 7.0, 0.4, -0.2), limited.pressure(7.0, 3.0, 0.2, -0.4));
   EXPECT_DOUBLE_EQ(acoustic.velocity(3.0, 7.0, 0.4, -0.2), -acoustic.velocity(7.0, 3.0, 0.2, -0.4));
+}
+
+TEST(Riemann, ContinuityOnlyKeepsTheDensityDiffusionAndDropsTheVelocityJump) {
+  const RiemannSolver none{1000.0 * 20.0, 20.0, MomentumDissipation::none},
+      acoustic{1000.0 * 20.0, 20.0, MomentumDissipation::acoustic};
+  // P* is the mean pressure whatever the velocities, even for a fast impact.
+  EXPECT_DOUBLE_EQ(none.pressure(3.0, 7.0, 10.0, -10.0), 5.0);
+  EXPECT_DOUBLE_EQ(none.pressure(3.0, 7.0, -1.0, 1.0), 5.0);
+  // U* still carries the pressure jump (p_L - p_R) / (2 Z), as the acoustic solver's does.
+  EXPECT_DOUBLE_EQ(none.velocity(100.0, 0.0, 0.0, 0.0), 100.0 / (2.0 * 20000.0));
+  EXPECT_DOUBLE_EQ(none.velocity(3.0, 7.0, 0.4, -0.2), acoustic.velocity(3.0, 7.0, 0.4, -0.2));
 }
 
 using test::make_simulation;
