@@ -539,17 +539,15 @@ class FluidModule final : public Module {
     const double rho0 = spec_.density(), sigma0 = reference_number_density_;
     const bool free_surface = spec_.density_treatment() == "reinitialisation";
     const auto sets = boundaries();
+    const auto views = boundary_views(sets);  // field lookups once, not per particle
     const auto truncated = open_.truncation(fluid_);
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       double sigma = m[i] / rho0 * kernel_.value(0.0);
       for (Index j : inner_.of(i))
         sigma += m[j] / rho0 * kernel_.value(domain_.displacement(x[i], x[j]).norm());
-      for (const BoundarySet<D>* b : sets) {
-        const auto& bx = b->particles.vector("position");
-        const auto& bV = b->particles.scalar("volume");
-        for (Index w : b->list.of(i))
-          sigma += bV[w] * kernel_.value(domain_.displacement(x[i], bx[w]).norm());
-      }
+      for (std::size_t s = 0; s < sets.size(); ++s)
+        for (Index w : sets[s]->list.of(i))
+          sigma += views[s].V[w] * kernel_.value(domain_.displacement(x[i], views[s].x[w]).norm());
       const double summed = rho0 * sigma / sigma0;
       rho[i] = free_surface || truncated(i) ? std::max(rho[i], summed) : summed;
     });
@@ -580,6 +578,7 @@ class FluidModule final : public Module {
     auto& a = fluid_.vector("acceleration");
     const double eta = spec_.viscosity();
     const auto sets = boundaries();
+    const auto views = boundary_views(sets);
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
       if (eta > 0.0) {
@@ -588,10 +587,11 @@ class FluidModule final : public Module {
           if (r <= 0.0) continue;
           sum += (m[j] / rho[j] * kernel_.derivative(r) / r) * (v[i] - v[j]);
         }
-        for (BoundarySet<D>* b : sets) {
-          const auto& bx = b->particles.vector("position");
-          const auto& bv = b->particles.vector("velocity");
-          const auto& bV = b->particles.scalar("volume");
+        for (std::size_t s = 0; s < sets.size(); ++s) {
+          BoundarySet<D>* b = sets[s];
+          const auto& bx = views[s].x;
+          const auto& bv = views[s].v;
+          const auto& bV = views[s].V;
           for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
             const Index w = b->list.index[k];
             const double r = domain_.displacement(x[i], bx[w]).norm();
@@ -621,6 +621,7 @@ class FluidModule final : public Module {
     const double h = kernel_.smoothing_length();
     shift_.resize(x.size());
     const auto sets = boundaries();
+    const auto views = boundary_views(sets);
     const auto truncated = open_.truncation(fluid_);
     for (int sweep = 0; sweep < spec_.transport_velocity_sweeps(); ++sweep) {
       parallel_for_each_index(x.size(), [&](std::size_t i) {
@@ -630,15 +631,12 @@ class FluidModule final : public Module {
           const double r = d.norm();
           if (r > 0.0) sum += volume[j] * kernel_.derivative(r) / r * d;
         }
-        for (const BoundarySet<D>* b : sets) {
-          const auto& bx = b->particles.vector("position");
-          const auto& bV = b->particles.scalar("volume");
-          for (Index w : b->list.of(i)) {
-            const Vec<D> d = domain_.displacement(x[i], bx[w]);
+        for (std::size_t s = 0; s < sets.size(); ++s)
+          for (Index w : sets[s]->list.of(i)) {
+            const Vec<D> d = domain_.displacement(x[i], views[s].x[w]);
             const double r = d.norm();
-            if (r > 0.0) sum += bV[w] * kernel_.derivative(r) / r * d;
+            if (r > 0.0) sum += views[s].V[w] * kernel_.derivative(r) / r * d;
           }
-        }
         shift_[i] = truncated(i) ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
       });
       parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift_[i]); });
