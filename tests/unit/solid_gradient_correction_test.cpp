@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "../support/tlsph_body.hpp"
 #include "kernels/kernel.hpp"
 #include "scene.pb.h"
 #include "solid_tlsph/material_model.hpp"
@@ -20,7 +21,7 @@
 namespace cosph {
 namespace {
 
-constexpr double kDp = 0.1;
+constexpr double kDp = test::kTestSpacing;
 
 // A lattice size: n2 in 2D, n3 in 3D.
 template <int D>
@@ -30,34 +31,16 @@ std::array<int, D> size_of(std::array<int, 2> n2, std::array<int, 3> n3) {
   return n;
 }
 
-// Cell-centred lattice of n[0] x n[1] (x n[2]) particles, each moved by up to jitter * dp.
 template <int D>
 std::vector<Vec<D>> box(const std::array<int, D>& n, double jitter, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-jitter * kDp, jitter * kDp);
-  int total = 1;
-  for (int a = 0; a < D; ++a) total *= n[a];
-  std::vector<Vec<D>> X(total);
-  for (int k = 0; k < total; ++k) {
-    int r = k;
-    for (int a = 0; a < D; ++a) {
-      X[k][a] = (r % n[a] + 0.5) * kDp + u(rng);
-      r /= n[a];
-    }
-  }
-  return X;
+  return test::lattice_box<D>(n, jitter, seed);
 }
 
+// A body of dp^D volumes with the given correction.
 template <int D>
-struct Body {
-  std::vector<Vec<D>> X;
-  std::vector<double> V;
-  Kernel kernel{KernelType::WendlandC2, D, 1.3 * kDp};
-  ReferencePairs<D> pairs;
-  Body(std::vector<Vec<D>> positions, GradientCorrection correction) : X(std::move(positions)) {
-    V.assign(X.size(), std::pow(kDp, D));
-    pairs = build_reference_pairs<D>(X, V, kernel, correction, false);
-  }
+struct Body : test::TlsphBody<D> {
+  Body(std::vector<Vec<D>> positions, GradientCorrection correction)
+      : test::TlsphBody<D>(test::make_tlsph_body<D>(std::move(positions), {}, correction, false)) {}
 };
 
 // A quadratic displacement u_a = sum_b A_ab X_b + sum_bc H_abc X_b X_c and its gradient.

@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/tlsph_body.hpp"
 #include "core/error.hpp"
 #include "driver/simulation.hpp"
 #include "kernels/kernel.hpp"
@@ -31,46 +33,22 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kDp = 0.1;
+constexpr double kDp = test::kTestSpacing;
 
-// Particles at the cell centres (k + 1/2) dp of an n^D lattice, each moved by up to jitter * dp
-// per axis.
 template <int D>
-std::vector<Vec<D>> lattice(int n, double jitter, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-jitter * kDp, jitter * kDp);
-  const int total = D == 2 ? n * n : n * n * n;
-  std::vector<Vec<D>> x(total);
-  for (int k = 0; k < total; ++k) {
-    int r = k;
-    for (int a = 0; a < D; ++a) {
-      x[k][a] = (r % n + 0.5) * kDp + u(rng);
-      r /= n;
-    }
-  }
-  return x;
-}
-
-// A body of reference positions, volumes (dp^D, or varied by up to volume_jitter), the kernel
-// WendlandC2 with h = 1.3 dp and its reference pairs.
-template <int D>
-struct Body {
-  std::vector<Vec<D>> X;
-  std::vector<double> V;
-  Kernel kernel{KernelType::WendlandC2, D, 1.3 * kDp};
-  ReferencePairs<D> pairs;
-};
+using Body = test::TlsphBody<D>;
 
 template <int D>
 Body<D> make_body(int n, double jitter, double volume_jitter, bool hourglass, unsigned seed,
                   GradientCorrection correction = GradientCorrection::linear) {
-  Body<D> b;
-  b.X = lattice<D>(n, jitter, seed);
+  std::array<int, D> size;
+  size.fill(n);
+  std::vector<Vec<D>> X = test::lattice_box<D>(size, jitter, seed);
   std::mt19937 rng(seed + 1000);
   std::uniform_real_distribution<double> u(-volume_jitter, volume_jitter);
-  for (std::size_t i = 0; i < b.X.size(); ++i) b.V.push_back(std::pow(kDp, D) * (1.0 + u(rng)));
-  b.pairs = build_reference_pairs<D>(b.X, b.V, b.kernel, correction, hourglass);
-  return b;
+  std::vector<double> V;
+  for (std::size_t i = 0; i < X.size(); ++i) V.push_back(std::pow(kDp, D) * (1.0 + u(rng)));
+  return test::make_tlsph_body<D>(std::move(X), std::move(V), correction, hourglass);
 }
 
 template <int D>
