@@ -29,14 +29,10 @@ CASES = [
     ("hydrostatic plate (0.0125 m, 0.5 s)", "examples/fsi_hydrostatic_plate.yaml",
      ["modules[0].fluid.body.spacing=0.0125", "end_time=0.5"], "test_2d_hydrostatic_fsi",
      "12800 / 352 / 1344"),
-    ("FSI2, 11 D channel (fluid D/10, solid D/20, 20 s)", "examples/fsi_turek_hron_fsi2.yaml",
+    ("FSI2, 11 D channel (fluid D/10, solid D/20, 20 s; one transport-velocity sweep per step, "
+     "as SPHinXsys)", "examples/fsi_turek_hron_fsi2.yaml",
      ["modules[0].fluid.body.shape.difference.base.box.upper=[1.1,0.41]",
       "modules[0].fluid.outflow.position=1.1"], "test_2d_fsi2", "5180 / 596 / 1104"),
-    ("FSI2 as above, one transport-velocity sweep per step (SPHinXsys's; the scene has eight)",
-     "examples/fsi_turek_hron_fsi2.yaml",
-     ["modules[0].fluid.body.shape.difference.base.box.upper=[1.1,0.41]",
-      "modules[0].fluid.outflow.position=1.1", "modules[0].fluid.transport_velocity_sweeps=1"],
-     "test_2d_fsi2", "5180 / 596 / 1104"),
 ]
 
 

@@ -4,6 +4,8 @@
 // loop in the same way, through the one-sided Riemann problem of seed 003 eqs. 14-16.
 #pragma once
 
+#include <algorithm>
+
 #include <optional>
 #include <vector>
 
@@ -76,7 +78,7 @@ std::vector<Vec<D>> recorded_force(const BoundarySet<D>& b) {
 // The state a boundary particle w presents to fluid particle i: the fluid's velocity mirrored
 // about the boundary's (no penetration, and no slip for the viscous term) and the fluid's
 // pressure extended hydrostatically to w, including the boundary's own acceleration a_w:
-// p_w = p_i + rho_i (g - a_w) . (x_w - x_i).
+// p_w = p_i + rho_i (g - a_w) . (x_w - x_i), the extension optionally clamped at zero.
 template <int D>
 struct OneSidedState {
   double pressure;
@@ -86,8 +88,9 @@ struct OneSidedState {
 template <int D>
 inline OneSidedState<D> one_sided_state(double p_i, double rho_i, const Vec<D>& v_i,
                                         const Vec<D>& v_w, const Vec<D>& g_minus_a,
-                                        const Vec<D>& x_w_minus_x_i) {
-  return {p_i + rho_i * g_minus_a.dot(x_w_minus_x_i), 2.0 * v_w - v_i};
+                                        const Vec<D>& x_w_minus_x_i, bool clamped) {
+  const double extension = rho_i * g_minus_a.dot(x_w_minus_x_i);
+  return {p_i + (clamped ? std::max(0.0, extension) : extension), 2.0 * v_w - v_i};
 }
 
 }  // namespace cosph

@@ -83,6 +83,7 @@ class FluidModule final : public Module {
       f.push_back("transport velocity (" + std::to_string(spec_.transport_velocity_sweeps()) +
                   " sweeps)");
     if (spec_.walls_size() > 0) f.push_back("walls (one-sided Riemann)");
+    if (spec_.pressure_extension() == "clamped") f.push_back("pressure extension clamped at zero");
     for (const auto& o : open_.features()) f.push_back(o);
     if (domain_.any_periodic()) f.push_back("periodic");
     for (const auto& o : spec_.outputs()) f.push_back("output " + o);
@@ -651,21 +652,25 @@ class FluidModule final : public Module {
     const std::vector<double>& V;
     const std::vector<Vec<D>>* a;
     Vec<D> g;
-    BoundaryView(const BoundarySet<D>& b, const Vec<D>& gravity)
+    bool clamped;  // the pressure extension clamped at zero
+    BoundaryView(const BoundarySet<D>& b, const Vec<D>& gravity, bool clamped_extension)
         : x(b.particles.vector("position")),
           v(b.particles.vector("velocity")),
           V(b.particles.scalar("volume")),
           a(b.particles.has("acceleration") ? &b.particles.vector("acceleration") : nullptr),
-          g(gravity) {}
+          g(gravity),
+          clamped(clamped_extension) {}
     OneSidedState<D> state(Index w, double p_i, double rho_i, const Vec<D>& v_i,
                            const Vec<D>& x_w_minus_x_i) const {
-      return one_sided_state<D>(p_i, rho_i, v_i, v[w], a ? Vec<D>(g - (*a)[w]) : g, x_w_minus_x_i);
+      return one_sided_state<D>(p_i, rho_i, v_i, v[w], a ? Vec<D>(g - (*a)[w]) : g, x_w_minus_x_i,
+                                clamped);
     }
   };
 
   std::vector<BoundaryView> boundary_views(const std::vector<BoundarySet<D>*>& sets) const {
     std::vector<BoundaryView> views;
-    for (const BoundarySet<D>* b : sets) views.emplace_back(*b, gravity_);
+    const bool clamped = spec_.pressure_extension() == "clamped";
+    for (const BoundarySet<D>* b : sets) views.emplace_back(*b, gravity_, clamped);
     return views;
   }
 

@@ -129,7 +129,8 @@ Vec<D> artificial_viscosity(const ReferencePairs<D>& pairs, const std::vector<Ve
                             std::size_t i) {
   const auto& nl = pairs.neighbours;
   const double h = p.smoothing_length;
-  Vec<D> sum = Vec<D>::Zero();
+  // A_i is common to the pairs of i: sum q_ij g_ij first, one product with A_i at the end.
+  Vec<D> own = Vec<D>::Zero(), others = Vec<D>::Zero();
   for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
     const Index j = nl.index[k];
     const Vec<D> r = x[i] - x[j];
@@ -137,9 +138,10 @@ Vec<D> artificial_viscosity(const ReferencePairs<D>& pairs, const std::vector<Ve
     if (phi >= 0.0) continue;
     const double q =
         0.25 * (density[i] + density[j]) * (-p.alpha * p.sound_speed * phi + p.beta * phi * phi);
-    sum.noalias() -= q * (A[i] * pairs.gradient[k] + A[j] * pairs.reverse[k]);
+    own.noalias() += q * pairs.gradient[k];
+    others.noalias() += q * (A[j] * pairs.reverse[k]);
   }
-  return sum;
+  return -(A[i] * own + others);
 }
 
 template <int D>

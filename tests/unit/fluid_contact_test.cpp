@@ -114,12 +114,19 @@ TEST(FluidContact, TankAsContactParticlesIsBitIdenticalToTankAsWalls) {
 
 TEST(FluidContact, OneSidedStateMirrorsVelocityAndExtendsPressureWithTheAcceleration) {
   const Vec<2> v_i(1.0, 2.0), v_w(0.5, -1.0), g(0.0, -9.81), r(0.0, -0.1);
-  const auto still = one_sided_state<2>(100.0, 1000.0, v_i, v_w, g, r);
-  EXPECT_DOUBLE_EQ(still.pressure, 100.0 + 1000.0 * 9.81 * 0.1);  // hydrostatic below i
-  EXPECT_EQ(still.velocity, Vec<2>(0.0, -4.0));                   // 2 v_w - v_i
-  // A boundary falling freely (a_w = g) carries no hydrostatic pressure difference.
-  const auto falling = one_sided_state<2>(100.0, 1000.0, v_i, v_w, Vec<2>(g - g), r);
-  EXPECT_DOUBLE_EQ(falling.pressure, 100.0);
+  for (bool clamped : {false, true}) {
+    const auto still = one_sided_state<2>(100.0, 1000.0, v_i, v_w, g, r, clamped);
+    EXPECT_DOUBLE_EQ(still.pressure, 100.0 + 1000.0 * 9.81 * 0.1);  // hydrostatic below i
+    EXPECT_EQ(still.velocity, Vec<2>(0.0, -4.0));                   // 2 v_w - v_i
+    // A boundary falling freely (a_w = g) carries no hydrostatic pressure difference.
+    const auto falling = one_sided_state<2>(100.0, 1000.0, v_i, v_w, Vec<2>(g - g), r, clamped);
+    EXPECT_DOUBLE_EQ(falling.pressure, 100.0);
+  }
+  // A wall above i: hydrostatically lower, unless the extension is clamped at zero.
+  const Vec<2> above(0.0, 0.1);
+  EXPECT_DOUBLE_EQ(one_sided_state<2>(100.0, 1000.0, v_i, v_w, g, above, false).pressure,
+                   100.0 - 1000.0 * 9.81 * 0.1);
+  EXPECT_DOUBLE_EQ(one_sided_state<2>(100.0, 1000.0, v_i, v_w, g, above, true).pressure, 100.0);
 }
 
 TEST(FluidContact, MalformedPortDataIsRefused) {
