@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
 
@@ -122,12 +123,19 @@ class FluidModule final : public Module {
     build_neighbours();
   }
 
+  // The advection step follows the flow alone (dt = 0.25 h / max(|v|max, c/10)). Where viscosity
+  // allows less (0.25 rho h^2 / eta), the viscous force is sub-stepped instead: recomputed at
+  // every acoustic sub-step, whose size it then bounds too (viscous_dt), while the neighbour lists
+  // and the density summation stay once per advection step.
   double max_dt() const override {
-    const double h = kernel_.smoothing_length();
     const double speed = std::max(max_speed(), 0.1 * sound_speed_);
-    double dt = h / speed;
-    if (spec_.viscosity() > 0.0) dt = std::min(dt, h * h * spec_.density() / spec_.viscosity());
-    return spec_.advection_cfl() * dt;
+    return spec_.advection_cfl() * kernel_.smoothing_length() / speed;
+  }
+
+  double viscous_dt() const {
+    if (!(spec_.viscosity() > 0.0)) return std::numeric_limits<double>::infinity();
+    const double h = kernel_.smoothing_length();
+    return spec_.advection_cfl() * h * h * spec_.density() / spec_.viscosity();
   }
 
   // One advection step, through the same stages a coupler drives (Module::begin_step).
@@ -143,17 +151,20 @@ class FluidModule final : public Module {
     if (spec_.transport_velocity()) correct_transport_velocity();
     step_size_ = Dt;
     step_done_ = 0.0;
+    viscous_substeps_ = viscous_dt() < Dt;
   }
 
   // The acoustic step (dt = 0.6 h / (c + |v|max)), cut to what is left of the advection step.
   double max_substep() const override {
     if (step_done_ >= step_size_ * (1.0 - 1e-12)) return 0.0;
     const double h = kernel_.smoothing_length();
-    return std::min(spec_.acoustic_cfl() * h / (sound_speed_ + max_speed()),
-                    step_size_ - step_done_);
+    double dt = spec_.acoustic_cfl() * h / (sound_speed_ + max_speed());
+    if (viscous_substeps_) dt = std::min(dt, viscous_dt());
+    return std::min(dt, step_size_ - step_done_);
   }
 
   void substep(double dt) override {
+    if (viscous_substeps_ && step_done_ > 0.0) update_prior_acceleration();
     pressure_relaxation(time_ + step_done_, dt);
     density_relaxation(time_ + step_done_, dt);
     step_done_ += dt;
@@ -640,7 +651,7 @@ class FluidModule final : public Module {
           }
         shift_[i] = truncated(i) ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
       });
-      parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift_[i]); });
+      parallel_stream(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift_[i]); });
     }
   }
 
@@ -705,7 +716,7 @@ class FluidModule final : public Module {
     const auto& prior = fluid_.vector("acceleration");
     const double c2 = sound_speed_ * sound_speed_, rho0 = spec_.density();
     auto& volume = fluid_.scalar("volume");
-    parallel_for_each_index(x.size(), [&](std::size_t i) {
+    parallel_stream(x.size(), [&](std::size_t i) {
       rho[i] += 0.5 * dt * drho[i];
       p[i] = c2 * (rho[i] - rho0);
       volume[i] = m[i] / rho[i];
@@ -737,7 +748,7 @@ class FluidModule final : public Module {
                                   });
       dv_[i] = (2.0 / rho[i]) * sum;
     });
-    parallel_for_each_index(x.size(), [&](std::size_t i) { v[i] += dt * (dv_[i] + prior[i]); });
+    parallel_stream(x.size(), [&](std::size_t i) { v[i] += dt * (dv_[i] + prior[i]); });
     open_.impose(fluid_, t + dt);
   }
 
@@ -749,7 +760,7 @@ class FluidModule final : public Module {
     const auto& p = fluid_.scalar("pressure");
     auto& drho = fluid_.scalar("density_rate");
     const auto& volume = fluid_.scalar("volume");  // m / rho of the first half
-    parallel_for_each_index(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + 0.5 * dt * v[i]); });
+    parallel_stream(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + 0.5 * dt * v[i]); });
     move_walls(t, dt);
     const RiemannSolver solver = riemann();
     const auto sets = boundaries();
@@ -773,7 +784,7 @@ class FluidModule final : public Module {
                                   });
       drho[i] = 2.0 * rho[i] * sum;
     });
-    parallel_for_each_index(x.size(), [&](std::size_t i) { rho[i] += 0.5 * dt * drho[i]; });
+    parallel_stream(x.size(), [&](std::size_t i) { rho[i] += 0.5 * dt * drho[i]; });
   }
 
   std::string name_, key_;
@@ -796,6 +807,7 @@ class FluidModule final : public Module {
   std::vector<Vec<D>> dv_, shift_;
   double time_ = 0.0;
   double step_size_ = 0.0, step_done_ = 0.0;  // the open advection step (staged advance)
+  bool viscous_substeps_ = false;  // the viscous force recomputed at every acoustic sub-step
   long long steps_ = 0, acoustic_steps_ = 0;
 };
 

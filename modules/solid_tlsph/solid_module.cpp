@@ -523,9 +523,8 @@ class SolidModule final : public StaticBodyModule<D> {
     const bool viscosity = spec_.has_artificial_viscosity();
     const bool hourglass = spec_.has_hourglass_control();
     update_active_tension(t);
-    deformation_gradients<D>(pairs_, u, F_);
     parallel_for_each_index(n, [&](std::size_t i) {
-      const Mat<D>& F = F_[i];
+      const Mat<D>& F = F_[i] = deformation_gradient<D>(pairs_, u, i);
       const Mat<D> frame = frames_.empty() ? Mat<D>::Identity() : frames_[i];
       P_[i] = first_piola(i, F, frame);
       x_[i] = X_[i] + u[i];
@@ -583,9 +582,9 @@ class SolidModule final : public StaticBodyModule<D> {
       if (!(norm > 0.0) || !std::isfinite(norm)) break;
       // A unit vector of displacements, scaled so that a typical particle moves 1e-7 h.
       const double eps = 1e-7 * h * std::sqrt(double(n));
-      parallel_for_each_index(n, [&](std::size_t i) { shifted[i] = u[i] + (eps / norm) * q[i]; });
+      parallel_stream(n, [&](std::size_t i) { shifted[i] = u[i] + (eps / norm) * q[i]; });
       compute_acceleration(time_, shifted, v, a1);
-      parallel_for_each_index(n, [&](std::size_t i) { q[i] = (a0[i] - a1[i]) / eps; });
+      parallel_stream(n, [&](std::size_t i) { q[i] = (a0[i] - a1[i]) / eps; });
       lambda =
           std::sqrt(deterministic_sum(n, 0.0, [&](std::size_t i) { return q[i].squaredNorm(); }));
     }
@@ -608,15 +607,15 @@ class SolidModule final : public StaticBodyModule<D> {
     auto& a = particles_.vector("acceleration");
     auto& x = particles_.vector("position");
     const double t = time_, half = 0.5 * dt, damping = 1.0 / (1.0 + spec_.damping() * dt);
-    parallel_for_each_index(u.size(), [&](std::size_t i) { u[i] += half * v[i]; });
+    parallel_stream(u.size(), [&](std::size_t i) { u[i] += half * v[i]; });
     apply_constraints(t + half, u, v);
     compute_acceleration(t + half, u, v, a);
-    parallel_for_each_index(u.size(), [&](std::size_t i) {
+    parallel_stream(u.size(), [&](std::size_t i) {
       v[i] = (v[i] + dt * a[i]) * damping;
       u[i] += half * v[i];
     });
     finish_constraints(t, dt, u, v);
-    parallel_for_each_index(u.size(), [&](std::size_t i) { x[i] = X_[i] + u[i]; });
+    parallel_stream(u.size(), [&](std::size_t i) { x[i] = X_[i] + u[i]; });
   }
 
   // Classical RK4 on (u, v) (seed 000), damping explicit in the rates.
@@ -636,25 +635,25 @@ class SolidModule final : public StaticBodyModule<D> {
     const double c[4] = {0.0, 0.5, 0.5, 1.0}, w[4] = {1.0 / 6, 2.0 / 6, 2.0 / 6, 1.0 / 6};
     for (int s = 0; s < 4; ++s) {
       if (s > 0)
-        parallel_for_each_index(n, [&](std::size_t i) {
+        parallel_stream(n, [&](std::size_t i) {
           const Vec<D> rate_u = vs_[i];  // the previous stage's rates: (v_s, a_s)
           us_[i] = u0_[i] + c[s] * dt * rate_u;
           vs_[i] = v0_[i] + c[s] * dt * a[i];
         });
       apply_constraints(t + c[s] * dt, us_, vs_);
       compute_acceleration(t + c[s] * dt, us_, vs_, a);
-      parallel_for_each_index(n, [&](std::size_t i) {
+      parallel_stream(n, [&](std::size_t i) {
         a[i] -= zeta * vs_[i];
         du_[i] += w[s] * vs_[i];
         dv_[i] += w[s] * a[i];
       });
     }
-    parallel_for_each_index(n, [&](std::size_t i) {
+    parallel_stream(n, [&](std::size_t i) {
       u[i] = u0_[i] + dt * du_[i];
       v[i] = v0_[i] + dt * dv_[i];
     });
     finish_constraints(t, dt, u, v);
-    parallel_for_each_index(n, [&](std::size_t i) { x[i] = X_[i] + u[i]; });
+    parallel_stream(n, [&](std::size_t i) { x[i] = X_[i] + u[i]; });
   }
 
   // End-of-step constraints: clamps and fixed components stay put, prescribed velocities take

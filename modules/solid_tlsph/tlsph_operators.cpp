@@ -113,13 +113,8 @@ ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
 template <int D>
 void deformation_gradients(const ReferencePairs<D>& pairs, const std::vector<Vec<D>>& u,
                            std::vector<Mat<D>>& F) {
-  const auto& nl = pairs.neighbours;
-  parallel_for_each_index(u.size(), [&](std::size_t i) {
-    Mat<D> G = Mat<D>::Zero();
-    for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k)
-      G.noalias() += (u[nl.index[k]] - u[i]) * pairs.gradient[k].transpose();
-    F[i] = Mat<D>::Identity() + G;
-  });
+  parallel_for_each_index(u.size(),
+                          [&](std::size_t i) { F[i] = deformation_gradient<D>(pairs, u, i); });
 }
 
 template <int D>

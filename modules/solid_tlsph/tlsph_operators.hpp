@@ -55,7 +55,18 @@ ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
                                         const std::vector<double>& volume, const Kernel& kernel,
                                         GradientCorrection correction, bool hourglass);
 
-// F_i from the displacements.
+// F_i = I + sum_j (u_j - u_i) g_ij^T from the displacements, for one particle (inline: the
+// solid fuses it with the stress in one loop) and for all.
+template <int D>
+Mat<D> deformation_gradient(const ReferencePairs<D>& pairs, const std::vector<Vec<D>>& u,
+                            std::size_t i) {
+  const auto& nl = pairs.neighbours;
+  Mat<D> G = Mat<D>::Zero();
+  for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k)
+    G.noalias() += (u[nl.index[k]] - u[i]) * pairs.gradient[k].transpose();
+  return Mat<D>::Identity() + G;
+}
+
 template <int D>
 void deformation_gradients(const ReferencePairs<D>& pairs, const std::vector<Vec<D>>& u,
                            std::vector<Mat<D>>& F);

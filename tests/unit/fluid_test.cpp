@@ -97,6 +97,42 @@ TEST(Fluid, PairForcesConserveMomentumInAPeriodicBox) {
   EXPECT_LT((after - before).norm(), 1e-12 * scale);
 }
 
+// A viscosity whose explicit limit (0.25 rho h^2 / eta) lies below the advection step is
+// sub-stepped: the advection step (neighbour lists, density summation) stays what the flow
+// allows, and every acoustic sub-step recomputes the viscous force and respects the limit. The
+// accuracy of the sub-stepped viscous force is the Poiseuille transient's (fluid_validation_test:
+// its viscous limit is below its advection step).
+TEST(Fluid, ViscosityBelowTheAdvectionStepIsSubSteppedNotTheStep) {
+  auto thin = make_simulation(kPeriodicBox, {});
+  auto thick = make_simulation(kPeriodicBox, {"modules[0].fluid.viscosity=1000"});
+  Module& fluid = thick->module(0);
+  const double Dt = fluid.max_dt();
+  EXPECT_DOUBLE_EQ(Dt, thin->module(0).max_dt());
+  const double h = 1.3 * 0.05, limit = 0.25 * h * h * 1000.0 / 1000.0;
+  ASSERT_LT(4.0 * limit, Dt);
+  const ParticleSet<2>& p = particles_of<2>(*thick);
+  auto kinetic = [&] {
+    double e = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      e += 0.5 * p.scalar("mass")[i] * p.vector("velocity")[i].squaredNorm();
+    return e;
+  };
+  double energy = kinetic();
+  for (int step = 0; step < 5; ++step) {
+    fluid.begin_step(fluid.max_dt());
+    int substeps = 0;
+    for (double dt; (dt = fluid.max_substep()) > 0.0; ++substeps) {
+      EXPECT_LE(dt, limit * (1.0 + 1e-12));
+      fluid.substep(dt);
+    }
+    fluid.end_step();
+    EXPECT_GE(substeps, 4);
+    const double now = kinetic();
+    EXPECT_LT(now, energy) << "step " << step;  // a viscosity this strong only removes energy
+    energy = now;
+  }
+}
+
 const char* kTank = R"yaml(
 dimension: 2
 end_time: 2.0
