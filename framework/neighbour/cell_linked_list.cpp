@@ -63,6 +63,11 @@ CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double c
   particles_.resize(n);
   std::vector<std::size_t> fill(cell_start_.begin(), cell_start_.end() - 1);
   for (std::size_t i = 0; i < n; ++i) particles_[fill[cell[i]]++] = static_cast<Index>(i);
+  std::size_t fullest = 0;
+  for (std::size_t c = 0; c < total; ++c)
+    fullest = std::max(fullest, cell_start_[c + 1] - cell_start_[c]);
+  candidate_bound_ = fullest;
+  for (int a = 0; a < D; ++a) candidate_bound_ *= 3;
   sorted_positions_.resize(n);
   parallel_for_each_index(n,
                           [&](std::size_t p) { sorted_positions_[p] = positions[particles_[p]]; });
@@ -97,8 +102,10 @@ namespace {
 // their neighbours into block-local buffers in parallel; a prefix sum over the blocks then places
 // every block in the CSR arrays. The lists come out in the same order whatever the number of
 // threads, without atomics, and the search runs once instead of the count-then-fill twice.
-template <int D, typename ForEach>
-NeighbourList build_list(std::size_t n, const ForEach& for_each) {
+// write(i, out) stores particle i's neighbours from out on and returns their end; out has room
+// for `bound` indices.
+template <typename Write>
+NeighbourList build_list(std::size_t n, std::size_t bound, const Write& write) {
   constexpr std::size_t kBlock = 128;
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<std::vector<Index>> found(blocks);
@@ -113,12 +120,16 @@ NeighbourList build_list(std::size_t n, const ForEach& for_each) {
   };
   each_block([&](std::size_t b) {
     auto& buffer = found[b];
+    std::size_t used = 0;
     const std::size_t end = std::min(n, (b + 1) * kBlock);
     for (std::size_t i = b * kBlock; i < end; ++i) {
-      const std::size_t before = buffer.size();
-      for_each(i, [&](Index j) { buffer.push_back(j); });
-      list.offset[i + 1] = buffer.size() - before;  // count for now, offsets below
+      if (buffer.size() < used + bound) buffer.resize(std::max(2 * buffer.size(), used + bound));
+      Index* const from = buffer.data() + used;
+      const std::size_t count = static_cast<std::size_t>(write(i, from) - from);
+      list.offset[i + 1] = count;  // count for now, offsets below
+      used += count;
     }
+    buffer.resize(used);
   });
   for (std::size_t i = 0; i < n; ++i) list.offset[i + 1] += list.offset[i];
   list.index.resize(list.offset[n]);
@@ -135,27 +146,24 @@ template <int D>
 NeighbourList build_inner_list(const std::vector<Vec<D>>& positions, double cutoff,
                                const Domain<D>& domain) {
   CellLinkedList<D> cells(positions, cutoff, domain);
-  return build_list<D>(positions.size(), [&](std::size_t i, const auto& emit) {
-    cells.for_each_neighbour(positions[i], cutoff, static_cast<Index>(i), emit);
+  return build_list(positions.size(), cells.candidate_bound(), [&](std::size_t i, Index* out) {
+    return cells.write_neighbours(positions[i], cutoff, static_cast<Index>(i), out);
   });
 }
 
 template <int D>
 NeighbourList build_contact_list(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b,
                                  double cutoff, const Domain<D>& domain) {
-  CellLinkedList<D> cells(b, cutoff, domain);
-  constexpr Index none = static_cast<Index>(-1);
-  return build_list<D>(a.size(), [&](std::size_t i, const auto& emit) {
-    cells.for_each_neighbour(a[i], cutoff, none, emit);
-  });
+  const CellLinkedList<D> cells(b, cutoff, domain);
+  return build_contact_list<D>(a, cells, cutoff);
 }
 
 template <int D>
 NeighbourList build_contact_list(const std::vector<Vec<D>>& a, const CellLinkedList<D>& cells,
                                  double cutoff) {
   constexpr Index none = static_cast<Index>(-1);
-  return build_list<D>(a.size(), [&](std::size_t i, const auto& emit) {
-    cells.for_each_neighbour(a[i], cutoff, none, emit);
+  return build_list(a.size(), cells.candidate_bound(), [&](std::size_t i, Index* out) {
+    return cells.write_neighbours(a[i], cutoff, none, out);
   });
 }
 

@@ -27,12 +27,25 @@ class CellLinkedList {
   template <typename F>
   void for_each_neighbour(const Vec<D>& x, double cutoff, Index self, const F& f) const;
 
+  // The same neighbours, in the same order, written to out[0..) without a branch per candidate
+  // (every candidate is stored, and the write position advances only on a hit: a third of the
+  // candidates are neighbours, a coin toss for branch prediction). out must have room for
+  // candidate_bound() indices; returns the end of what was written.
+  Index* write_neighbours(const Vec<D>& x, double cutoff, Index self, Index* out) const;
+
+  // The most candidates one search visits: 3^D cells of the fullest cell's size.
+  std::size_t candidate_bound() const { return candidate_bound_; }
+
   // Particle indices in cell order: positions[order[k]] are sorted by cell.
   std::vector<Index> cell_order() const { return particles_; }
 
  private:
   std::array<int, D> cell_of_position(const Vec<D>& x) const;
   std::size_t linear(const std::array<int, D>& c) const;
+  // Calls f(begin, end) for the ranges of particles_ that hold the 3^D cells around x (wrapped
+  // on periodic axes, clipped elsewhere), in increasing cell order.
+  template <typename F>
+  void for_each_range_around(const Vec<D>& x, const F& f) const;
 
   const std::vector<Vec<D>>& positions_;
   Domain<D> domain_;
@@ -43,6 +56,7 @@ class CellLinkedList {
   std::vector<Index> particles_;         // particle indices grouped by cell
   std::vector<Vec<D>>
       sorted_positions_;  // positions in the same order: candidates stream from memory
+  std::size_t candidate_bound_ = 0;
 };
 
 // Neighbours of every particle of one set among the same set (self excluded).
@@ -73,11 +87,8 @@ std::vector<Index> cell_sort_order(const std::vector<Vec<D>>& positions, double 
 
 template <int D>
 template <typename F>
-void CellLinkedList<D>::for_each_neighbour(const Vec<D>& x, double cutoff, Index self,
-                                           const F& f) const {
-  const double cutoff2 = cutoff * cutoff;
+void CellLinkedList<D>::for_each_range_around(const Vec<D>& x, const F& f) const {
   const auto c = cell_of_position(x);
-  const bool periodic = domain_.any_periodic();
   std::array<int, D> lo, hi;
   for (int a = 0; a < D; ++a) {
     lo[a] = c[a] - 1;
@@ -87,30 +98,72 @@ void CellLinkedList<D>::for_each_neighbour(const Vec<D>& x, double cutoff, Index
       hi[a] = std::min(hi[a], cells_[a] - 1);
     }
   }
+  // Cells along axis 0 are consecutive in the linear index, so a row of the stencil is one range
+  // of particles_, except where it wraps around a periodic axis 0.
+  const int n0 = cells_[0];
   std::array<int, D> k = lo;
   while (true) {
     std::array<int, D> w = k;
-    for (int a = 0; a < D; ++a)
+    for (int a = 1; a < D; ++a)
       if (domain_.periodic[a]) w[a] = (w[a] + cells_[a]) % cells_[a];
-    const std::size_t cell = linear(w);
-    const std::size_t end = cell_start_[cell + 1];
-    if (periodic) {
-      for (std::size_t p = cell_start_[cell]; p < end; ++p)
-        if (particles_[p] != self &&
-            domain_.displacement(x, sorted_positions_[p]).squaredNorm() < cutoff2)
-          f(particles_[p]);
+    auto row = [&](int from, int to) {  // cells [from, to] of axis 0, in range
+      w[0] = from;
+      const std::size_t first = linear(w);
+      f(cell_start_[first], cell_start_[first + static_cast<std::size_t>(to - from) + 1]);
+    };
+    if (lo[0] < 0) {  // periodic, wraps below: cell n0 - 1, then 0 .. hi
+      row(n0 - 1, n0 - 1);
+      row(0, hi[0]);
+    } else if (hi[0] >= n0) {  // periodic, wraps above: lo .. n0 - 1, then 0
+      row(lo[0], n0 - 1);
+      row(0, 0);
     } else {
-      for (std::size_t p = cell_start_[cell]; p < end; ++p)
-        if (particles_[p] != self && (x - sorted_positions_[p]).squaredNorm() < cutoff2)
-          f(particles_[p]);
+      row(lo[0], hi[0]);
     }
-    int a = 0;
+    int a = 1;
     for (; a < D; ++a) {
       if (++k[a] <= hi[a]) break;
       k[a] = lo[a];
     }
     if (a == D) break;
   }
+}
+
+template <int D>
+template <typename F>
+void CellLinkedList<D>::for_each_neighbour(const Vec<D>& x, double cutoff, Index self,
+                                           const F& f) const {
+  const double cutoff2 = cutoff * cutoff;
+  const bool periodic = domain_.any_periodic();
+  for_each_range_around(x, [&](std::size_t begin, std::size_t end) {
+    if (periodic) {
+      for (std::size_t p = begin; p < end; ++p)
+        if (particles_[p] != self &&
+            domain_.displacement(x, sorted_positions_[p]).squaredNorm() < cutoff2)
+          f(particles_[p]);
+    } else {
+      for (std::size_t p = begin; p < end; ++p)
+        if (particles_[p] != self && (x - sorted_positions_[p]).squaredNorm() < cutoff2)
+          f(particles_[p]);
+    }
+  });
+}
+
+template <int D>
+Index* CellLinkedList<D>::write_neighbours(const Vec<D>& x, double cutoff, Index self,
+                                           Index* out) const {
+  const double cutoff2 = cutoff * cutoff;
+  const bool periodic = domain_.any_periodic();
+  for_each_range_around(x, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t p = begin; p < end; ++p) {
+      const Index j = particles_[p];
+      const double r2 = periodic ? domain_.displacement(x, sorted_positions_[p]).squaredNorm()
+                                 : (x - sorted_positions_[p]).squaredNorm();
+      *out = j;
+      out += static_cast<int>(r2 < cutoff2) & static_cast<int>(j != self);
+    }
+  });
+  return out;
 }
 
 }  // namespace cosph
