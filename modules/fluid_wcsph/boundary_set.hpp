@@ -14,12 +14,14 @@
 
 namespace cosph {
 
-// Per pair of a neighbour list, the unit vector e_ij = (x_j - x_i) / r_ij and -dW/dr(r_ij) >= 0
-// at the configuration of the advection step (the acoustic sub-steps reuse them).
+// Per pair of a neighbour list, the unit vector e_ij = (x_j - x_i) / r_ij, -dW/dr(r_ij) >= 0 and
+// r_ij at the configuration of the advection step (the acoustic sub-steps reuse them, and so do
+// the advection step's own loops until the transport shift moves the particles).
 template <int D>
 struct PairGeometry {
   std::vector<Vec<D>> direction;
   std::vector<double> gradient;
+  std::vector<double> distance;
 };
 
 template <int D>

@@ -147,7 +147,7 @@ class FluidModule final : public Module {
     if (steps_ > 0 && steps_ % kSortInterval == 0) sort_by_cell();
     build_neighbours();
     if (spec_.density_treatment() != "none") update_density_by_summation();
-    update_prior_acceleration();
+    update_prior_acceleration(true);
     if (spec_.transport_velocity()) correct_transport_velocity();
     step_size_ = Dt;
     step_done_ = 0.0;
@@ -164,7 +164,7 @@ class FluidModule final : public Module {
   }
 
   void substep(double dt) override {
-    if (viscous_substeps_ && step_done_ > 0.0) update_prior_acceleration();
+    if (viscous_substeps_ && step_done_ > 0.0) update_prior_acceleration(false);
     pressure_relaxation(time_ + step_done_, dt);
     density_relaxation(time_ + step_done_, dt);
     step_done_ += dt;
@@ -532,6 +532,7 @@ class FluidModule final : public Module {
                      const NeighbourList& list, PairGeometry<D>& g) const {
     g.direction.resize(list.pair_count());
     g.gradient.resize(list.pair_count());
+    g.distance.resize(list.pair_count());
     parallel_for_each_index(a.size(), [&](std::size_t i) {
       for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k) {
         const Vec<D> d = domain_.displacement(b[list.index[k]], a[i]);
@@ -539,6 +540,7 @@ class FluidModule final : public Module {
         const bool ok = r > 0.0;
         g.direction[k] = ok ? Vec<D>(d / r) : Vec<D>(Vec<D>::Zero());
         g.gradient[k] = ok ? -kernel_.derivative(r) : 0.0;
+        g.distance[k] = r;
       }
     });
   }
@@ -555,11 +557,14 @@ class FluidModule final : public Module {
     const auto truncated = open_.truncation(fluid_);
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       double sigma = m[i] / rho0 * kernel_.value(0.0);
-      for (Index j : inner_.of(i))
-        sigma += m[j] / rho0 * kernel_.value(domain_.displacement(x[i], x[j]).norm());
-      for (std::size_t s = 0; s < sets.size(); ++s)
-        for (Index w : sets[s]->list.of(i))
-          sigma += views[s].V[w] * kernel_.value(domain_.displacement(x[i], views[s].x[w]).norm());
+      for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k)
+        sigma += m[inner_.index[k]] / rho0 * kernel_.value(inner_geometry_.distance[k]);
+      for (std::size_t s = 0; s < sets.size(); ++s) {
+        const auto& list = sets[s]->list;
+        const auto& r = sets[s]->geometry.distance;
+        for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k)
+          sigma += views[s].V[list.index[k]] * kernel_.value(r[k]);
+      }
       const double summed = rho0 * sigma / sigma0;
       rho[i] = free_surface || truncated(i) ? std::max(rho[i], summed) : summed;
     });
@@ -582,7 +587,8 @@ class FluidModule final : public Module {
 
   // Gravity and viscosity (seed 003 eq. 10), once per advection step; walls are no-slip through
   // the mirrored velocity 2 v_wall - v_i.
-  void update_prior_acceleration() {
+  // at_build: the particles are where the neighbour lists were built (the pair geometry holds).
+  void update_prior_acceleration(bool at_build) {
     const auto& x = fluid_.vector("position");
     const auto& v = fluid_.vector("velocity");
     const auto& rho = fluid_.scalar("density");
@@ -594,10 +600,13 @@ class FluidModule final : public Module {
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
       if (eta > 0.0) {
-        for (Index j : inner_.of(i)) {
-          const double r = domain_.displacement(x[i], x[j]).norm();
+        for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
+          const Index j = inner_.index[k];
+          const double r =
+              at_build ? inner_geometry_.distance[k] : domain_.displacement(x[i], x[j]).norm();
           if (r <= 0.0) continue;
-          sum += (m[j] / rho[j] * kernel_.derivative(r) / r) * (v[i] - v[j]);
+          const double dW = at_build ? -inner_geometry_.gradient[k] : kernel_.derivative(r);
+          sum += (m[j] / rho[j] * dW / r) * (v[i] - v[j]);
         }
         for (std::size_t s = 0; s < sets.size(); ++s) {
           BoundarySet<D>* b = sets[s];
@@ -606,13 +615,15 @@ class FluidModule final : public Module {
           const auto& bV = views[s].V;
           for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
             const Index w = b->list.index[k];
-            const double r = domain_.displacement(x[i], bx[w]).norm();
+            const double r =
+                at_build ? b->geometry.distance[k] : domain_.displacement(x[i], bx[w]).norm();
             if (r <= 0.0) continue;
-            sum += (bV[w] * kernel_.derivative(r) / r) * (2.0 * (v[i] - bv[w]));
+            const double dW = at_build ? -b->geometry.gradient[k] : kernel_.derivative(r);
+            sum += (bV[w] * dW / r) * (2.0 * (v[i] - bv[w]));
             // Its reaction: m_i a_i = 4 eta V_i V_w dW/r (v_i - v_w), V_i = m_i / rho_i.
             if (b->records)
               b->pair_viscous_force[k] =
-                  (-4.0 * eta * m[i] / rho[i] * bV[w] * kernel_.derivative(r) / r) * (v[i] - bv[w]);
+                  (-4.0 * eta * m[i] / rho[i] * bV[w] * dW / r) * (v[i] - bv[w]);
           }
         }
         sum *= 2.0 * eta / rho[i];
@@ -636,19 +647,35 @@ class FluidModule final : public Module {
     const auto views = boundary_views(sets);
     const auto truncated = open_.truncation(fluid_);
     for (int sweep = 0; sweep < spec_.transport_velocity_sweeps(); ++sweep) {
+      // The first sweep finds the particles where the lists were built: sum_j V_j grad W_ij =
+      // sum_j V_j (-dW/dr) e_ij from the pair geometry.
+      const bool at_build = sweep == 0;
       parallel_for_each_index(x.size(), [&](std::size_t i) {
         Vec<D> sum = Vec<D>::Zero();
-        for (Index j : inner_.of(i)) {
+        for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
+          const Index j = inner_.index[k];
+          if (at_build) {
+            sum += (volume[j] * inner_geometry_.gradient[k]) * inner_geometry_.direction[k];
+            continue;
+          }
           const Vec<D> d = domain_.displacement(x[i], x[j]);
           const double r = d.norm();
           if (r > 0.0) sum += volume[j] * kernel_.derivative(r) / r * d;
         }
-        for (std::size_t s = 0; s < sets.size(); ++s)
-          for (Index w : sets[s]->list.of(i)) {
+        for (std::size_t s = 0; s < sets.size(); ++s) {
+          const auto& list = sets[s]->list;
+          const auto& g = sets[s]->geometry;
+          for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k) {
+            const Index w = list.index[k];
+            if (at_build) {
+              sum += (views[s].V[w] * g.gradient[k]) * g.direction[k];
+              continue;
+            }
             const Vec<D> d = domain_.displacement(x[i], views[s].x[w]);
             const double r = d.norm();
             if (r > 0.0) sum += views[s].V[w] * kernel_.derivative(r) / r * d;
           }
+        }
         shift_[i] = truncated(i) ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
       });
       parallel_stream(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift_[i]); });
