@@ -44,6 +44,7 @@ struct ReferencePairs {
   std::vector<Vec<D>> reverse;          // b_ij = -(V_j / V_i) g_ji, one per pair
   std::vector<Vec<D>> gradient_sum;     // sum_j g_ij, one per particle
   std::size_t quadratic_particles = 0;  // particles with the quadratic correction
+  std::vector<char> quadratic;          // per particle: 1 where the quadratic correction holds
   // Only with hourglass control: V_j W_ij / |X_ij|^2 per pair.
   std::vector<double> hourglass_weight;
 };
