@@ -147,7 +147,7 @@ class FluidModule final : public Module {
     if (steps_ > 0 && steps_ % kSortInterval == 0) sort_by_cell();
     build_neighbours();
     if (spec_.density_treatment() != "none") update_density_by_summation();
-    update_prior_acceleration(true);
+    update_prior_acceleration();
     if (spec_.transport_velocity()) correct_transport_velocity();
     step_size_ = Dt;
     step_done_ = 0.0;
@@ -164,7 +164,7 @@ class FluidModule final : public Module {
   }
 
   void substep(double dt) override {
-    if (viscous_substeps_ && step_done_ > 0.0) update_prior_acceleration(false);
+    if (viscous_substeps_ && step_done_ > 0.0) update_prior_acceleration();
     pressure_relaxation(time_ + step_done_, dt);
     density_relaxation(time_ + step_done_, dt);
     step_done_ += dt;
@@ -587,9 +587,9 @@ class FluidModule final : public Module {
 
   // Gravity and viscosity (seed 003 eq. 10), once per advection step; walls are no-slip through
   // the mirrored velocity 2 v_wall - v_i.
-  // at_build: the particles are where the neighbour lists were built (the pair geometry holds).
-  void update_prior_acceleration(bool at_build) {
-    const auto& x = fluid_.vector("position");
+  // With the pair geometry of the advection step, as the acoustic sub-steps' pressure terms
+  // (also when the viscous force is sub-stepped).
+  void update_prior_acceleration() {
     const auto& v = fluid_.vector("velocity");
     const auto& rho = fluid_.scalar("density");
     const auto& m = fluid_.scalar("mass");
@@ -597,28 +597,24 @@ class FluidModule final : public Module {
     const double eta = spec_.viscosity();
     const auto sets = boundaries();
     const auto views = boundary_views(sets);
-    parallel_for_each_index(x.size(), [&](std::size_t i) {
+    parallel_for_each_index(v.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
       if (eta > 0.0) {
         for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
           const Index j = inner_.index[k];
-          const double r =
-              at_build ? inner_geometry_.distance[k] : domain_.displacement(x[i], x[j]).norm();
+          const double r = inner_geometry_.distance[k];
           if (r <= 0.0) continue;
-          const double dW = at_build ? -inner_geometry_.gradient[k] : kernel_.derivative(r);
-          sum += (m[j] / rho[j] * dW / r) * (v[i] - v[j]);
+          sum += (m[j] / rho[j] * -inner_geometry_.gradient[k] / r) * (v[i] - v[j]);
         }
         for (std::size_t s = 0; s < sets.size(); ++s) {
           BoundarySet<D>* b = sets[s];
-          const auto& bx = views[s].x;
           const auto& bv = views[s].v;
           const auto& bV = views[s].V;
           for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
             const Index w = b->list.index[k];
-            const double r =
-                at_build ? b->geometry.distance[k] : domain_.displacement(x[i], bx[w]).norm();
+            const double r = b->geometry.distance[k];
             if (r <= 0.0) continue;
-            const double dW = at_build ? -b->geometry.gradient[k] : kernel_.derivative(r);
+            const double dW = -b->geometry.gradient[k];
             sum += (bV[w] * dW / r) * (2.0 * (v[i] - bv[w]));
             // Its reaction: m_i a_i = 4 eta V_i V_w dW/r (v_i - v_w), V_i = m_i / rho_i.
             if (b->records)
