@@ -52,9 +52,15 @@ def run_peer(peer: Path, target: str) -> float:
     """Wall seconds of one SPHinXsys run from its bin folder, writing no state files."""
     bin_dir = peer / target / "bin"
     start = time.perf_counter()
-    subprocess.run([str(bin_dir / target), "--state_recording=false"], cwd=bin_dir, check=True,
-                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return time.perf_counter() - start
+    # Its exit status is its own regression test's verdict against its stored results, which
+    # test_2d_hydrostatic_fsi's random-choice damping fails now and then after a complete run.
+    done = subprocess.run([str(bin_dir / target), "--state_recording=false"], cwd=bin_dir,
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    seconds = time.perf_counter() - start
+    if done.returncode != 0:
+        print(f"note: {target} exited with {done.returncode} (its regression check) after "
+              f"{seconds:.1f} s", flush=True)
+    return seconds
 
 
 def run_cosph(cosph: str, scene: str, overrides: list) -> tuple:
