@@ -151,20 +151,22 @@ class FluidModule final : public Module {
     if (spec_.transport_velocity()) correct_transport_velocity();
     step_size_ = Dt;
     step_done_ = 0.0;
-    viscous_substeps_ = viscous_dt() < Dt;
   }
+
+  // Whether the open advection step sub-steps the viscous force (see max_dt).
+  bool viscous_substeps() const { return viscous_dt() < step_size_; }
 
   // The acoustic step (dt = 0.6 h / (c + |v|max)), cut to what is left of the advection step.
   double max_substep() const override {
     if (step_done_ >= step_size_ * (1.0 - 1e-12)) return 0.0;
     const double h = kernel_.smoothing_length();
     double dt = spec_.acoustic_cfl() * h / (sound_speed_ + max_speed());
-    if (viscous_substeps_) dt = std::min(dt, viscous_dt());
+    if (viscous_substeps()) dt = std::min(dt, viscous_dt());
     return std::min(dt, step_size_ - step_done_);
   }
 
   void substep(double dt) override {
-    if (viscous_substeps_ && step_done_ > 0.0) update_prior_acceleration();
+    if (viscous_substeps() && step_done_ > 0.0) update_prior_acceleration();
     pressure_relaxation(time_ + step_done_, dt);
     density_relaxation(time_ + step_done_, dt);
     step_done_ += dt;
@@ -585,10 +587,10 @@ class FluidModule final : public Module {
     for (std::size_t i = 0; i < rho.size(); ++i) volume[i] = m[i] / rho[i];
   }
 
-  // Gravity and viscosity (seed 003 eq. 10), once per advection step; walls are no-slip through
-  // the mirrored velocity 2 v_wall - v_i.
-  // With the pair geometry of the advection step, as the acoustic sub-steps' pressure terms
-  // (also when the viscous force is sub-stepped).
+  // Gravity and viscosity (seed 003 eq. 10), once per advection step, or at every acoustic
+  // sub-step when the viscous force is sub-stepped; walls are no-slip through the mirrored
+  // velocity 2 v_wall - v_i. With the pair geometry of the advection step, as the acoustic
+  // sub-steps' pressure terms.
   void update_prior_acceleration() {
     const auto& v = fluid_.vector("velocity");
     const auto& rho = fluid_.scalar("density");
@@ -830,7 +832,6 @@ class FluidModule final : public Module {
   std::vector<Vec<D>> dv_, shift_;
   double time_ = 0.0;
   double step_size_ = 0.0, step_done_ = 0.0;  // the open advection step (staged advance)
-  bool viscous_substeps_ = false;  // the viscous force recomputed at every acoustic sub-step
   long long steps_ = 0, acoustic_steps_ = 0;
 };
 

@@ -58,7 +58,7 @@ class SolidModule final : public StaticBodyModule<D> {
     f.push_back("total-Lagrangian SPH, kernel " + kernel_name(kernel_.type()) +
                 ", corrected gradients");
     if (spec_.gradient_correction() == "quadratic")
-      f.push_back("quadratic gradient correction (" + std::to_string(pairs_.quadratic_particles) +
+      f.push_back("quadratic gradient correction (" + std::to_string(pairs_.quadratic_particles()) +
                   " of " + std::to_string(X_.size()) + " particles)");
     f.push_back(spec_.integrator() == "rk4" ? "RK4 integrator" : "position Verlet integrator");
     if (spec_.has_artificial_viscosity()) f.push_back("artificial viscosity");

@@ -120,7 +120,6 @@ ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
     for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) sum += pairs.gradient[k];
     pairs.gradient_sum[i] = sum;
   });
-  for (char q : quadratic) pairs.quadratic_particles += q;
   pairs.quadratic = std::move(quadratic);
   reverse_gradients<D>(nl, volume, pairs);
   return pairs;

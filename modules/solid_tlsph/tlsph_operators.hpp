@@ -27,6 +27,7 @@
 // some direction, e.g. a body one or two particles thick) keeps the linear correction.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "core/types.hpp"
@@ -39,12 +40,14 @@ enum class GradientCorrection { linear, quadratic };
 
 template <int D>
 struct ReferencePairs {
-  NeighbourList neighbours;             // in the reference configuration, self excluded
-  std::vector<Vec<D>> gradient;         // g_ij, one per pair
-  std::vector<Vec<D>> reverse;          // b_ij = -(V_j / V_i) g_ji, one per pair
-  std::vector<Vec<D>> gradient_sum;     // sum_j g_ij, one per particle
-  std::size_t quadratic_particles = 0;  // particles with the quadratic correction
-  std::vector<char> quadratic;          // per particle: 1 where the quadratic correction holds
+  NeighbourList neighbours;          // in the reference configuration, self excluded
+  std::vector<Vec<D>> gradient;      // g_ij, one per pair
+  std::vector<Vec<D>> reverse;       // b_ij = -(V_j / V_i) g_ji, one per pair
+  std::vector<Vec<D>> gradient_sum;  // sum_j g_ij, one per particle
+  std::vector<char> quadratic;       // per particle: 1 where the quadratic correction holds
+  std::size_t quadratic_particles() const {
+    return static_cast<std::size_t>(std::count(quadratic.begin(), quadratic.end(), char(1)));
+  }
   // Only with hourglass control: V_j W_ij / |X_ij|^2 per pair.
   std::vector<double> hourglass_weight;
 };

@@ -80,7 +80,7 @@ Quadratic<D> random_quadratic(unsigned seed) {
 // for the linear correction's body).
 template <int D>
 double worst_gradient_error(const Body<D>& b, const Quadratic<D>& q) {
-  const bool only_quadratic = b.pairs.quadratic_particles > 0;
+  const bool only_quadratic = b.pairs.quadratic_particles() > 0;
   std::vector<Vec<D>> u(b.X.size());
   for (std::size_t i = 0; i < u.size(); ++i) u[i] = q.at(b.X[i]);
   std::vector<Mat<D>> F(u.size());
@@ -164,7 +164,7 @@ TEST(QuadraticCorrection, InsideARegularLatticeItIsTheLinearCorrection) {
 TEST(QuadraticCorrection, ABodyTwoParticlesThickKeepsTheLinearCorrection) {
   const Body<2> thin(box<2>({12, 2}, 0.0, 1), GradientCorrection::quadratic);
   const Body<2> linear(box<2>({12, 2}, 0.0, 1), GradientCorrection::linear);
-  EXPECT_EQ(thin.pairs.quadratic_particles, 0u);
+  EXPECT_EQ(thin.pairs.quadratic_particles(), 0u);
   for (std::size_t k = 0; k < thin.pairs.gradient.size(); ++k)
     ASSERT_EQ(thin.pairs.gradient[k], linear.pairs.gradient[k]);
 }
