@@ -12,7 +12,7 @@ namespace cosph {
 template <int D>
 CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double cutoff,
                                   const Domain<D>& domain)
-    : positions_(positions), domain_(domain), cell_size_(cutoff) {
+    : positions_(positions), domain_(domain), cell_size_(0.5 * cutoff) {
   if (!(cutoff > 0.0)) throw std::invalid_argument("cell-linked list: cut-off must be positive");
   Vec<D> lo = Vec<D>::Constant(0.0), hi = Vec<D>::Constant(0.0);
   if (!positions.empty()) {
@@ -31,19 +31,21 @@ CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double c
   const double max_cells = 4.0 * static_cast<double>(std::max<std::size_t>(positions.size(), 1));
   if (volume / std::pow(cell_size_, D) > max_cells)
     cell_size_ = std::max(cell_size_, std::pow(volume / max_cells, 1.0 / D));
+  reach_ = cell_size_ >= cutoff ? 1 : 2;
 
   for (int a = 0; a < D; ++a) {
     if (domain.periodic[a]) {
       origin_[a] = domain.lower[a];
       const double L = domain.length(a);
-      cells_[a] = static_cast<int>(std::floor(L / cutoff));
-      if (cells_[a] < 3)
+      if (std::floor(L / cutoff) < 3)
         throw std::invalid_argument(
             "periodic axis " + std::to_string(a) + " is " + std::to_string(L) +
             " long, shorter than three cut-off radii (" + std::to_string(3 * cutoff) + ")");
-      // On a periodic axis the cells must tile the period exactly; they stay >= cut-off wide.
-      if (cells_[a] > 3 && L / cells_[a] < cell_size_)
-        cells_[a] = std::max(3, static_cast<int>(std::floor(L / cell_size_)));
+      // On a periodic axis the cells must tile the period exactly; they stay at least
+      // cell_size_ wide, and there are at least 2 reach + 1 of them so that a stencil never
+      // meets the same cell twice (then L / (2 reach + 1) times reach still covers the cut-off,
+      // as L >= 3 cut-offs).
+      cells_[a] = std::max(2 * reach_ + 1, static_cast<int>(std::floor(L / cell_size_)));
     } else {
       origin_[a] = lo[a];
       cells_[a] = std::max(1, static_cast<int>(std::floor((hi[a] - lo[a]) / cell_size_)) + 1);
@@ -67,7 +69,7 @@ CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double c
   for (std::size_t c = 0; c < total; ++c)
     fullest = std::max(fullest, cell_start_[c + 1] - cell_start_[c]);
   candidate_bound_ = fullest;
-  for (int a = 0; a < D; ++a) candidate_bound_ *= 3;
+  for (int a = 0; a < D; ++a) candidate_bound_ *= static_cast<std::size_t>(2 * reach_ + 1);
   sorted_positions_.resize(n);
   parallel_for_each_index(n,
                           [&](std::size_t p) { sorted_positions_[p] = positions[particles_[p]]; });

@@ -20,8 +20,11 @@ namespace cosph {
 template <int D>
 struct PairGeometry {
   std::vector<Vec<D>> direction;
-  std::vector<double> gradient;
+  std::vector<double> gradient;  // -dW/dr
   std::vector<double> distance;
+  // -dW/dr / r, only with viscosity: its force is recomputed at every acoustic sub-step when the
+  // viscous limit is below the advection step, and the division would be redone each time.
+  std::vector<double> gradient_over_distance;
 };
 
 template <int D>

@@ -535,6 +535,8 @@ class FluidModule final : public Module {
     g.direction.resize(list.pair_count());
     g.gradient.resize(list.pair_count());
     g.distance.resize(list.pair_count());
+    const bool viscous = spec_.viscosity() > 0.0;
+    g.gradient_over_distance.resize(viscous ? list.pair_count() : 0);
     parallel_for_each_index(a.size(), [&](std::size_t i) {
       for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k) {
         const Vec<D> d = domain_.displacement(b[list.index[k]], a[i]);
@@ -543,6 +545,7 @@ class FluidModule final : public Module {
         g.direction[k] = ok ? Vec<D>(d / r) : Vec<D>(Vec<D>::Zero());
         g.gradient[k] = ok ? -kernel_.derivative(r) : 0.0;
         g.distance[k] = r;
+        if (viscous) g.gradient_over_distance[k] = ok ? g.gradient[k] / r : 0.0;
       }
     });
   }
@@ -599,29 +602,31 @@ class FluidModule final : public Module {
     const double eta = spec_.viscosity();
     const auto sets = boundaries();
     const auto views = boundary_views(sets);
+    // V_j = m_j / rho_j once per particle rather than once per pair.
+    if (eta > 0.0) viscous_volume_.resize(v.size());
+    if (eta > 0.0)
+      parallel_stream(v.size(), [&](std::size_t j) { viscous_volume_[j] = m[j] / rho[j]; });
     parallel_for_each_index(v.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
       if (eta > 0.0) {
+        // dW/r = -gradient_over_distance (0 for a pair at r = 0).
+        const auto& inner_dW_r = inner_geometry_.gradient_over_distance;
         for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
           const Index j = inner_.index[k];
-          const double r = inner_geometry_.distance[k];
-          if (r <= 0.0) continue;
-          sum += (m[j] / rho[j] * -inner_geometry_.gradient[k] / r) * (v[i] - v[j]);
+          sum -= (viscous_volume_[j] * inner_dW_r[k]) * (v[i] - v[j]);
         }
         for (std::size_t s = 0; s < sets.size(); ++s) {
           BoundarySet<D>* b = sets[s];
           const auto& bv = views[s].v;
           const auto& bV = views[s].V;
+          const auto& dW_r = b->geometry.gradient_over_distance;
           for (std::size_t k = b->list.offset[i]; k < b->list.offset[i + 1]; ++k) {
             const Index w = b->list.index[k];
-            const double r = b->geometry.distance[k];
-            if (r <= 0.0) continue;
-            const double dW = -b->geometry.gradient[k];
-            sum += (bV[w] * dW / r) * (2.0 * (v[i] - bv[w]));
+            sum -= (bV[w] * dW_r[k]) * (2.0 * (v[i] - bv[w]));
             // Its reaction: m_i a_i = 4 eta V_i V_w dW/r (v_i - v_w), V_i = m_i / rho_i.
             if (b->records)
               b->pair_viscous_force[k] =
-                  (-4.0 * eta * m[i] / rho[i] * bV[w] * dW / r) * (v[i] - bv[w]);
+                  (4.0 * eta * m[i] / rho[i] * bV[w] * dW_r[k]) * (v[i] - bv[w]);
           }
         }
         sum *= 2.0 * eta / rho[i];
@@ -830,6 +835,7 @@ class FluidModule final : public Module {
   NeighbourList inner_;
   PairGeometry<D> inner_geometry_;
   std::vector<Vec<D>> dv_, shift_;
+  std::vector<double> viscous_volume_;  // m / rho per particle, for the viscous force
   double time_ = 0.0;
   double step_size_ = 0.0, step_done_ = 0.0;  // the open advection step (staged advance)
   long long steps_ = 0, acoustic_steps_ = 0;
