@@ -493,6 +493,27 @@ void check_restart_and_threads(const std::string& integrator) {
                        integrator + " 1 vs 2 threads");
 }
 
+// The two bounds of the step have their own factors: where the eigenvalue bound is the smaller
+// (this plate with the quadratic correction: its limit is below eq. 42's), the step scales with
+// eigenvalue_step_factor alone and time_step_factor does not move it; with the eigenvalue factor
+// at 1 and the time-step factor small, eq. 42 takes over.
+TEST(SolidModule, EigenvalueBoundHasItsOwnFactor) {
+  auto step = [](const std::vector<std::string>& extra) {
+    std::vector<std::string> overrides = {"modules[0].solid.gradient_correction=quadratic"};
+    overrides.insert(overrides.end(), extra.begin(), extra.end());
+    return make_simulation(kPlate, overrides)->module(0).max_dt();
+  };
+  const double base = step({});
+  EXPECT_DOUBLE_EQ(step({"modules[0].solid.eigenvalue_step_factor=0.35"}), 0.5 * base);
+  EXPECT_DOUBLE_EQ(step({"modules[0].solid.time_step_factor=0.9"}), base);
+  const double eq42 =
+      step({"modules[0].solid.eigenvalue_step_factor=1", "modules[0].solid.time_step_factor=0.05"});
+  EXPECT_LT(eq42, 0.5 * base);
+  EXPECT_DOUBLE_EQ(step({"modules[0].solid.eigenvalue_step_factor=1",
+                         "modules[0].solid.time_step_factor=0.025"}),
+                   0.5 * eq42);
+}
+
 TEST(SolidModule, RestartAndThreadsAreBitIdenticalVerlet) { check_restart_and_threads("verlet"); }
 TEST(SolidModule, RestartAndThreadsAreBitIdenticalRk4) { check_restart_and_threads("rk4"); }
 
