@@ -602,10 +602,10 @@ class FluidModule final : public Module {
     const double eta = spec_.viscosity();
     const auto sets = boundaries();
     const auto views = boundary_views(sets);
-    // V_j = m_j / rho_j once per particle rather than once per pair.
-    if (eta > 0.0) viscous_volume_.resize(v.size());
-    if (eta > 0.0)
+    if (eta > 0.0) {  // V_j = m_j / rho_j once per particle rather than once per pair
+      viscous_volume_.resize(v.size());
       parallel_stream(v.size(), [&](std::size_t j) { viscous_volume_[j] = m[j] / rho[j]; });
+    }
     parallel_for_each_index(v.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
       if (eta > 0.0) {
