@@ -136,7 +136,10 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
         check_field(names[k],
                     path + (line ? ".line" : ".points") + ".fields[" + std::to_string(k) + "]");
       ProbeOptions options;
-      options.linear = spec.interpolation() == "linear";
+      options.interpolation =
+          spec.interpolation() == "quadratic" ? ProbeOptions::Interpolation::quadratic
+          : spec.interpolation() == "linear"  ? ProbeOptions::Interpolation::linear
+                                              : ProbeOptions::Interpolation::shepard;
       if (spec.configuration() == "reference") {
         options.position_field = "reference_position";
         if (!particles.has(options.position_field))

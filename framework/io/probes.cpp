@@ -45,6 +45,36 @@ FieldView resolve(const ParticleSet<D>& particles, const std::string& spec) {
   return {};  // not reached: require_field throws
 }
 
+// The fit's basis: 1, then the D components of d, then the D (D + 1) / 2 products d_a d_b
+// (a <= b). basis_size(order) says how many of them a fit of that order uses.
+template <int D>
+constexpr int kBasisMax = (D + 1) * (D + 2) / 2;
+
+template <int D>
+int basis_size(int order) {
+  return order == 0 ? 1 : order == 1 ? D + 1 : kBasisMax<D>;
+}
+
+template <int D>
+Eigen::Matrix<double, kBasisMax<D>, 1> basis(const Vec<D>& d) {
+  Eigen::Matrix<double, kBasisMax<D>, 1> b;
+  b[0] = 1.0;
+  int k = 1;
+  for (int a = 0; a < D; ++a) b[k++] = d[a];
+  for (int a = 0; a < D; ++a)
+    for (int c = a; c < D; ++c) b[k++] = d[a] * d[c];
+  return b;
+}
+
+template <int D>
+Eigen::Matrix<double, kBasisMax<D>, 1> basis_scale(double h) {
+  Eigen::Matrix<double, kBasisMax<D>, 1> s;
+  s.setConstant(1.0 / (h * h));
+  s[0] = 1.0;
+  s.template segment<D>(1).setConstant(1.0 / h);
+  return s;
+}
+
 }  // namespace
 
 template <int D>
@@ -53,7 +83,8 @@ PointProbe<D>::PointProbe(std::vector<Vec<D>> points, std::vector<std::string> f
     : points_(std::move(points)),
       fields_(std::move(fields)),
       labels_(std::move(labels)),
-      options_(std::move(options)) {
+      options_(std::move(options)),
+      order_(static_cast<int>(options_.interpolation)) {
   if (labels_.empty())
     for (std::size_t p = 0; p < points_.size(); ++p) {
       // Appended rather than "p" + to_string(p), which trips GCC 12's false -Wrestrict
@@ -113,40 +144,37 @@ std::vector<double> PointProbe<D>::sample(const ParticleSet<D>& particles,
   const CellLinkedList<D> cells(x, support, domain);
   constexpr Index kNone = std::numeric_limits<Index>::max();
 
+  using Moment = Eigen::Matrix<double, kBasisMax<D>, kBasisMax<D>>;
+  using Basis = Eigen::Matrix<double, kBasisMax<D>, 1>;
   parallel_for_each_index(np, [&](std::size_t p) {
     const Vec<D> point = domain.wrap(points_[p]);
     if (!point.allFinite()) return;
     for (int a = 0; a < D; ++a)
       if (!domain.periodic[a] && (point[a] < lo[a] - support || point[a] > hi[a] + support)) return;
-    // Moments of the weighted linear fit: M = sum w [1, d^T; d, d d^T], r_f = sum w f [1; d]
-    // with d = x_j - x (only the first row and column when Shepard is asked for).
-    using Moment = Eigen::Matrix<double, D + 1, D + 1>;
-    using Basis = Eigen::Matrix<double, D + 1, 1>;
+    // Moments of the weighted fit: M = sum w b b^T, r_f = sum w f b, with the basis
+    // b = [1, d, (d d^T)'s upper triangle] truncated to the order asked, d = x_j - x.
     Moment M = Moment::Zero();
     std::vector<Basis> rhs(nf, Basis::Zero());
+    const int size = basis_size<D>(order_);
     cells.for_each_neighbour(point, support, kNone, [&](Index j) {
       const Vec<D> d = domain.displacement(x[j], point);
       const double w = volumes[j] * kernel.value(d.norm());
-      Basis basis;
-      basis << 1.0, d;
-      if (options_.linear)
-        M += w * basis * basis.transpose();
-      else
-        M(0, 0) += w;
+      const Basis b = basis<D>(d);
+      M.topLeftCorner(size, size).noalias() += w * b.head(size) * b.head(size).transpose();
       for (std::size_t f = 0; f < nf; ++f)
-        rhs[f] += (w * views[f].data[j * views[f].stride + views[f].component]) * basis;
+        rhs[f] += (w * views[f].data[j * views[f].stride + views[f].component]) * b;
     });
     if (M(0, 0) == 0.0) return;  // NaN stays: nothing (of non-zero volume) within the support
-    if (options_.linear) {
-      // Scaled so that the condition number reflects geometry, not units.
-      const double h = kernel.smoothing_length();
-      Basis scale = Basis::Constant(1.0 / h);
-      scale[0] = 1.0;
-      const Moment S = scale.asDiagonal() * M * scale.asDiagonal();
-      const Eigen::FullPivLU<Moment> lu(S);
-      if (lu.rank() == D + 1 && lu.rcond() > 1e-6) {
+    // Scaled by h per power of d so that the condition number reflects geometry, not units.
+    const Basis scale = basis_scale<D>(kernel.smoothing_length());
+    for (int order = order_; order > 0; --order) {
+      const int n = basis_size<D>(order);
+      const auto s = scale.head(n).asDiagonal();
+      const Eigen::MatrixXd S = s * M.topLeftCorner(n, n) * s;
+      const Eigen::FullPivLU<Eigen::MatrixXd> lu(S);
+      if (lu.rank() == n && lu.rcond() > 1e-6) {
         for (std::size_t f = 0; f < nf; ++f) {
-          const Basis c = lu.solve(scale.asDiagonal() * rhs[f]);
+          const Eigen::VectorXd c = lu.solve(s * rhs[f].head(n));
           values[f * np + p] = c[0];  // a = f at the point (scale[0] = 1)
         }
         return;

@@ -25,10 +25,14 @@ struct ProbeOptions {
   // The vector field holding the positions the points refer to: "position" (current
   // configuration) or, for material points of a moving body, "reference_position".
   std::string position_field = "position";
-  // false: Shepard average. true: linear moving least squares, f(x) = a of the weighted fit
+  // shepard: the normalised average. linear: moving least squares, f(x) = a of the weighted fit
   // f_j ~ a + b . (x_j - x), exact for linear fields also at corners and edges where the average
-  // is biased by the one-sided neighbourhood (falls back to Shepard where the fit is singular).
-  bool linear = false;
+  // is biased by the one-sided neighbourhood. quadratic: the same fit with the second-order
+  // terms, exact for quadratic fields: the average and the linear fit both smooth a curved field
+  // by O(h^2) (a Gaussian of width 4 h reads 1.5% low at its peak), which can exceed the error of
+  // the particle values themselves. Each falls back to the lower order where its fit is singular.
+  enum class Interpolation { shepard, linear, quadratic };
+  Interpolation interpolation = Interpolation::shepard;
 };
 
 template <int D>
@@ -65,6 +69,7 @@ class PointProbe {
   std::vector<std::string> fields_;
   std::vector<std::string> labels_;
   ProbeOptions options_;
+  int order_;  // of the fit: 0 Shepard, 1 linear, 2 quadratic
 };
 
 extern template class PointProbe<2>;

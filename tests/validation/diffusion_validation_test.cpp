@@ -1,6 +1,7 @@
 // Diffusion against analytic solutions (../shared/reference/README.md, seed 001 section 5.1): the
-// example scenes run in-process at two resolutions; the L2 error must be small and fall with
-// resolution, with and without kernel correction.
+// example scenes run in-process at two resolutions; the relative L2 error (volume-weighted, over
+// all particles at the end time) sits within 1.5x of its measured value and falls with resolution
+// at the measured rate, with and without kernel correction.
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
@@ -70,6 +71,7 @@ double isotropic_gaussian_exact(double x, double y, double t) {
 }
 
 TEST(DiffusionValidation, IsotropicGaussianErrorIsSmallAndFallsWithResolution) {
+  std::cout.precision(6);
   const auto scene = example("diffusion_2d_anisotropic.yaml");
   const std::string iso = "modules[0].diffusion.anisotropy.across=1.0e-4";  // along = across
   const double coarse = relative_l2_error(scene, {iso, "modules[0].diffusion.body.spacing=0.02"},
@@ -78,11 +80,14 @@ TEST(DiffusionValidation, IsotropicGaussianErrorIsSmallAndFallsWithResolution) {
                                         isotropic_gaussian_exact);
   std::cout << "isotropic Gaussian relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine
             << "\n";
-  EXPECT_LT(fine, 0.002);
-  EXPECT_LT(fine, 0.3 * coarse);
+  // Measured: 5.549e-3 and 4.515e-4 (ratio 12.3: above second order on this smooth field).
+  EXPECT_LT(coarse, 8.3e-3);
+  EXPECT_LT(fine, 6.8e-4);
+  EXPECT_LT(fine, 0.12 * coarse);
 }
 
 TEST(DiffusionValidation, TopHatErrorIsSmallAndFallsWithResolution) {
+  std::cout.precision(6);
   const auto scene = example("diffusion_1d_tophat.yaml");
   const double coarse =
       relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.02"}, tophat_exact);
@@ -91,11 +96,14 @@ TEST(DiffusionValidation, TopHatErrorIsSmallAndFallsWithResolution) {
   RecordProperty("coarse", std::to_string(coarse));
   RecordProperty("fine", std::to_string(fine));
   std::cout << "top hat relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine << "\n";
-  EXPECT_LT(fine, 0.02);
-  EXPECT_LT(fine, 0.6 * coarse);
+  // Measured: 2.817e-3 and 5.750e-4 (ratio 4.9: the erf profile's sharp start limits the order).
+  EXPECT_LT(coarse, 4.2e-3);
+  EXPECT_LT(fine, 8.6e-4);
+  EXPECT_LT(fine, 0.31 * coarse);
 }
 
 TEST(DiffusionValidation, AnisotropicGaussianErrorIsSmallAndFallsWithResolution) {
+  std::cout.precision(6);
   const auto scene = example("diffusion_2d_anisotropic.yaml");
   const double coarse =
       relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.02"}, anisotropic_exact);
@@ -103,11 +111,14 @@ TEST(DiffusionValidation, AnisotropicGaussianErrorIsSmallAndFallsWithResolution)
       relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
   std::cout << "anisotropic Gaussian relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine
             << "\n";
-  EXPECT_LT(fine, 0.002);
-  EXPECT_LT(fine, 0.3 * coarse);  // at least second order: halving dp divides the error by 4
+  // Measured: 2.920e-3 and 2.755e-4 (ratio 10.6).
+  EXPECT_LT(coarse, 4.4e-3);
+  EXPECT_LT(fine, 4.1e-4);
+  EXPECT_LT(fine, 0.14 * coarse);
 }
 
 TEST(DiffusionValidation, KernelCorrectionIsWhatMakesAnisotropicDiffusionConverge) {
+  std::cout.precision(6);
   // Without the second-moment correction the lattice samples the anisotropic weight at a few
   // directions only, and the error stays at a few percent however fine the particles are.
   const auto scene = example("diffusion_2d_anisotropic.yaml");
@@ -120,8 +131,10 @@ TEST(DiffusionValidation, KernelCorrectionIsWhatMakesAnisotropicDiffusionConverg
       relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
   std::cout << "uncorrected: dp=0.02 " << coarse << ", dp=0.01 " << fine << "; corrected dp=0.01 "
             << corrected << "\n";
-  EXPECT_GT(fine, 0.5 * coarse);
-  EXPECT_LT(corrected, 0.1 * fine);
+  // Measured: 4.582e-2 and 4.694e-2 uncorrected (no convergence), 2.755e-4 corrected.
+  EXPECT_GT(fine, 0.031);
+  EXPECT_GT(fine, 0.9 * coarse);
+  EXPECT_LT(corrected, 0.009 * fine);
 }
 
 TEST(DiffusionValidation, TotalAmountIsConservedToRoundOff) {
@@ -194,11 +207,14 @@ modules:
 }
 
 TEST(DiffusionValidation, AnisotropicGaussian3DErrorIsSmallAndFallsWithResolution) {
+  std::cout.precision(6);
   const double coarse = gaussian_3d_error(0.1), fine = gaussian_3d_error(0.05);
   std::cout << "3D anisotropic Gaussian relative L2 error: dp=0.1 " << coarse << ", dp=0.05 "
             << fine << "\n";
-  EXPECT_LT(fine, 0.02);           // measured 1.36e-2 (2 particles per initial sigma)
-  EXPECT_LT(fine, 0.35 * coarse);  // measured ratio 4: second order
+  // Measured: 5.781e-2 and 1.397e-2 (2 particles per initial sigma; ratio 4.1, second order).
+  EXPECT_LT(coarse, 8.7e-2);
+  EXPECT_LT(fine, 2.1e-2);
+  EXPECT_LT(fine, 0.36 * coarse);
 }
 
 }  // namespace
