@@ -1,0 +1,126 @@
+// Each module's own health check, and the domain check, triggered by a scene built to violate it:
+// the run stops with a HealthError that names the module, the quantity, its value, the particle
+// and what was expected (the diffusion module's maximum principle and non-finite values are
+// tested in tests/stability/diffusion_stability_test.cpp).
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "driver/health_monitor.hpp"
+#include "driver/simulation.hpp"
+#include "module_catalogue.hpp"
+
+namespace cosph {
+namespace {
+
+// Runs the scene and returns the health error's message; fails the test if the run finishes.
+std::string health_error(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  RunOptions options;
+  options.bench = true;
+  options.progress = false;
+  Simulation simulation(load_scene_text(text, "unhealthy.yaml", overrides), builtin_modules(),
+                        options);
+  simulation.initialize();
+  try {
+    simulation.run();
+  } catch (const HealthError& e) {
+    std::cout << e.what() << "\n";
+    return e.what();
+  }
+  ADD_FAILURE() << "the run should have been stopped by the health monitor";
+  return {};
+}
+
+void expect_contains(const std::string& message, const std::vector<std::string>& parts) {
+  for (const auto& part : parts)
+    EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+}
+
+const char* const kTissue = R"yaml(
+dimension: 2
+end_time: 0.1
+run: {health_interval: 1}
+modules:
+  - name: tissue
+    monodomain:
+      body: {spacing: 0.1, shape: {box: {lower: [0, 0], upper: [1, 1]}}}
+      diffusivity: 1.0
+      ionic_model: {preset: aliev_panfilov_table1}
+)yaml";
+
+TEST(HealthChecks, MonodomainVoltageOutsideTheModelsRange) {
+  // Aliev-Panfilov's voltage range is [-0.5, 1.5] (ionic_model.hpp).
+  const std::string message = health_error(kTissue, {"modules[0].monodomain.initial_voltage=3"});
+  expect_contains(message, {"health check failed at step 0 ", "module 'tissue'", "voltage = 3",
+                            "at particle 0", "position (", "expected within [-0.5, 1.5]"});
+}
+
+TEST(HealthChecks, MonodomainGateOutsideTheModelsRange) {
+  const std::string message = health_error(kTissue, {"modules[0].monodomain.initial_gate=-1"});
+  expect_contains(message, {"module 'tissue'", "gate = -1", "at particle 0"});
+}
+
+TEST(HealthChecks, SolidInvertedNeighbourhood) {
+  // The prescribed displacement u_x = -2 x mirrors the block: F = diag(-1, 1), J = -1.
+  const std::string message = health_error(R"yaml(
+dimension: 2
+end_time: 1.0e-3
+run: {health_interval: 1}
+modules:
+  - name: block
+    solid:
+      body: {spacing: 0.1, shape: {box: {lower: [0, 0], upper: [1, 1]}}}
+      material:
+        density: 1000
+        neo_hookean: {young: 1.0e4, poisson: 0.3}
+      constraints:
+        - region: {name: all, shape: {box: {lower: [-1, -1], upper: [2, 2]}}}
+          displacement: {values: ["-2 * x", "0"]}
+)yaml");
+  expect_contains(message, {"module 'block'", "J = -1", "tangled particles"});
+}
+
+TEST(HealthChecks, FluidDensityOutsideTheWeaklyCompressibleBand) {
+  // p = c^2 (rho - rho0): 2e5 Pa at c = 10 m/s is rho = 3 rho0.
+  const std::string message = health_error(R"yaml(
+dimension: 2
+end_time: 0.01
+run: {health_interval: 1}
+modules:
+  - name: water
+    fluid:
+      body: {spacing: 0.05, shape: {box: {lower: [0, 0], upper: [0.5, 0.5]}}}
+      density: 1000
+      sound_speed: 10
+      initial_pressure: "2.0e5"
+)yaml");
+  expect_contains(message, {"module 'water'", "density = 3000", "within 30% of rho0"});
+}
+
+TEST(HealthChecks, ParticleLeavingTheDomain) {
+  // A block of water in free fall above the domain's floor: its lowest particles (y = 0.025)
+  // cross y = -0.05 after sqrt(2 0.075 / 9.81) = 0.124 s.
+  const std::string message = health_error(R"yaml(
+dimension: 2
+end_time: 0.3
+domain: {lower: [-1, -0.05], upper: [2, 1]}
+run: {health_interval: 1}
+modules:
+  - name: water
+    fluid:
+      body: {spacing: 0.05, shape: {box: {lower: [0, 0], upper: [0.5, 0.5]}}}
+      density: 1000
+      sound_speed: 10
+      gravity: [0, -9.81]
+)yaml");
+  expect_contains(message, {"module 'water'", "position.y = -0.0", "inside the domain"});
+  const auto at = message.find("(t = ");
+  ASSERT_NE(at, std::string::npos) << message;
+  const double t = std::stod(message.substr(at + 5));
+  EXPECT_GT(t, 0.120) << message;
+  EXPECT_LT(t, 0.130) << message;
+}
+
+}  // namespace
+}  // namespace cosph
