@@ -7,23 +7,16 @@
 #include <string>
 #include <vector>
 
+#include "../support/simulation_setup.hpp"
 #include "driver/health_monitor.hpp"
-#include "driver/simulation.hpp"
-#include "module_catalogue.hpp"
 
 namespace cosph {
 namespace {
 
 // Runs the scene and returns the health error's message; fails the test if the run finishes.
 std::string health_error(const std::string& text, const std::vector<std::string>& overrides = {}) {
-  RunOptions options;
-  options.bench = true;
-  options.progress = false;
-  Simulation simulation(load_scene_text(text, "unhealthy.yaml", overrides), builtin_modules(),
-                        options);
-  simulation.initialize();
   try {
-    simulation.run();
+    test::make_simulation(text, overrides)->run();
   } catch (const HealthError& e) {
     std::cout << e.what() << "\n";
     return e.what();
@@ -81,27 +74,8 @@ modules:
   expect_contains(message, {"module 'block'", "J = -1", "tangled particles"});
 }
 
-TEST(HealthChecks, FluidDensityOutsideTheWeaklyCompressibleBand) {
-  // p = c^2 (rho - rho0): 2e5 Pa at c = 10 m/s is rho = 3 rho0.
-  const std::string message = health_error(R"yaml(
-dimension: 2
-end_time: 0.01
-run: {health_interval: 1}
-modules:
-  - name: water
-    fluid:
-      body: {spacing: 0.05, shape: {box: {lower: [0, 0], upper: [0.5, 0.5]}}}
-      density: 1000
-      sound_speed: 10
-      initial_pressure: "2.0e5"
-)yaml");
-  expect_contains(message, {"module 'water'", "density = 3000", "within 30% of rho0"});
-}
-
-TEST(HealthChecks, ParticleLeavingTheDomain) {
-  // A block of water in free fall above the domain's floor: its lowest particles (y = 0.025)
-  // cross y = -0.05 after sqrt(2 0.075 / 9.81) = 0.124 s.
-  const std::string message = health_error(R"yaml(
+// A block of water, 0.5 x 0.5 at spacing 0.05, c = 10 m/s, checked at every step.
+const char* const kWater = R"yaml(
 dimension: 2
 end_time: 0.3
 domain: {lower: [-1, -0.05], upper: [2, 1]}
@@ -112,8 +86,18 @@ modules:
       body: {spacing: 0.05, shape: {box: {lower: [0, 0], upper: [0.5, 0.5]}}}
       density: 1000
       sound_speed: 10
-      gravity: [0, -9.81]
-)yaml");
+)yaml";
+
+TEST(HealthChecks, FluidDensityOutsideTheWeaklyCompressibleBand) {
+  // p = c^2 (rho - rho0): 2e5 Pa at c = 10 m/s is rho = 3 rho0.
+  const std::string message = health_error(kWater, {"modules[0].fluid.initial_pressure=2.0e5"});
+  expect_contains(message, {"module 'water'", "density = 3000", "within 30% of rho0"});
+}
+
+TEST(HealthChecks, ParticleLeavingTheDomain) {
+  // In free fall above the domain's floor, the lowest particles (y = 0.025) cross y = -0.05
+  // after sqrt(2 0.075 / 9.81) = 0.124 s.
+  const std::string message = health_error(kWater, {"modules[0].fluid.gravity=[0, -9.81]"});
   expect_contains(message, {"module 'water'", "position.y = -0.0", "inside the domain"});
   const auto at = message.find("(t = ");
   ASSERT_NE(at, std::string::npos) << message;
