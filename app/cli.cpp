@@ -27,6 +27,7 @@ options of run:
   --restart FILE         continue from a checkpoint file
   --bench                write no files; print steps and particle-steps per second
   --end-time T           stop at T instead of the scene's end_time
+  --steps N              stop after N steps (a smoke run: output, probes and summary as at the end)
   --health on|off        health monitor (default on, every run.health_interval steps): stops a
                          run whose values turn non-finite or leave their physical bounds
   --quiet                no progress line
@@ -85,6 +86,10 @@ Arguments parse(const std::vector<std::string>& args) {
     } else if (s == "--end-time") {
       a.options.end_time = number(value(), "--end-time");
       if (!(a.options.end_time > 0)) throw UsageError("--end-time must be positive");
+    } else if (s == "--steps") {
+      const double n = number(value(), "--steps");
+      if (n < 1 || n != std::floor(n)) throw UsageError("--steps expects a positive integer");
+      a.options.max_steps = static_cast<unsigned long long>(n);
     } else if (!s.empty() && s[0] == '-') {
       throw UsageError("unknown option '" + s + "'");
     } else if (a.scene.empty()) {

@@ -234,12 +234,22 @@ ProbeSet::ProbeSet(const proto::Scene& scene,
         out << "\n";
       }
     }
-    if (!directory.empty())
-      probe->csv = std::make_unique<CsvTimeSeries>(
-          (std::filesystem::path(directory) / (spec.name() + ".csv")).string(), probe->columns);
     probes_.push_back(std::move(probe));
   }
+  directory_ = directory;
 }
+
+void ProbeSet::open_files(std::optional<double> resume_time) {
+  if (directory_.empty()) return;
+  for (auto& p : probes_) {
+    std::string path = (std::filesystem::path(directory_) / (p->name + ".csv")).string();
+    p->csv = std::make_unique<CsvTimeSeries>(
+        resume_time ? CsvTimeSeries::resume(std::move(path), p->columns, *resume_time)
+                    : CsvTimeSeries(std::move(path), p->columns));
+  }
+}
+
+const std::string& ProbeSet::name(std::size_t k) const { return probes_[k]->name; }
 
 ProbeSet::~ProbeSet() = default;
 

@@ -4,6 +4,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,12 +16,18 @@ namespace cosph {
 class ProbeSet {
  public:
   // Resolves every probe against the modules' bodies; throws ConfigError naming the probe's key
-  // path if its module, body or fields do not exist. With an empty directory nothing is written.
+  // path if its module, body or fields do not exist. With an empty directory nothing is written;
+  // otherwise the sampling points' sidecar files now, the CSV files by open_files().
   ProbeSet(const proto::Scene& scene, const std::vector<std::pair<std::string, BodyViews>>& modules,
            const std::string& directory);
   ~ProbeSet();
 
+  // Opens each probe's CSV file (none without a directory): new files, or with `resume_time`
+  // the files of the run being restarted, continued after their rows up to that time.
+  void open_files(std::optional<double> resume_time);
+
   std::size_t size() const;
+  const std::string& name(std::size_t probe) const;
   double interval(std::size_t probe) const;  // 0: at every output
   // Samples probe k at time t and appends a row to its CSV.
   void sample(std::size_t probe, double time);
@@ -31,6 +38,7 @@ class ProbeSet {
 
  private:
   std::vector<std::unique_ptr<Probe>> probes_;
+  std::string directory_;
 };
 
 }  // namespace cosph

@@ -56,6 +56,7 @@ std::string json_escape(const std::string& s) {
 }
 
 std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";  // JSON has no NaN or infinity
   if (!std::isfinite(v)) return "null";
   std::ostringstream s;
   s << std::setprecision(17) << v;
@@ -78,6 +79,8 @@ std::string fingerprint(const proto::Scene& scene) {
   s << std::hex << fnv1a64(bytes);
   return s.str();
 }
+
+std::string probe_schedule_key(const std::string& probe) { return "probe_next:" + probe; }
 
 }  // namespace
 
@@ -148,6 +151,7 @@ struct Simulation::Impl {
   std::unique_ptr<ProbeSet> probes;
   std::vector<std::pair<std::unique_ptr<PvdCollection>, const void*>> pvds;
   Schedule output, checkpoint;
+  std::optional<double> resume_time;  // a restarted run's start: its files continue from there
   std::vector<Schedule> probe_schedules;
   unsigned long long output_index = 0;
   double time = 0.0;
@@ -243,7 +247,9 @@ RunSummary Simulation::run() {
       if (I.pvds.size() <= body) {
         const std::string pvd =
             (std::filesystem::path(I.directory) / (view.particles->name() + ".pvd")).string();
-        I.pvds.emplace_back(std::make_unique<PvdCollection>(pvd), view.particles);
+        I.pvds.emplace_back(I.resume_time ? PvdCollection::resume(pvd, *I.resume_time)
+                                          : std::make_unique<PvdCollection>(pvd),
+                            view.particles);
       }
       std::ostringstream file;
       file << view.particles->name() << "_" << std::setw(6) << std::setfill('0') << I.output_index
@@ -274,8 +280,9 @@ RunSummary Simulation::run() {
     c.set_next_output(I.output.next);
     (*c.mutable_driver_scalars())["next_checkpoint"] = static_cast<double>(I.checkpoint.next);
     (*c.mutable_driver_scalars())["output_index"] = static_cast<double>(I.output_index);
+    // By name: a restart from this checkpoint may list the probes in another order, or others.
     for (std::size_t k = 0; k < I.probe_schedules.size(); ++k)
-      (*c.mutable_driver_scalars())["probe_next_" + std::to_string(k)] =
+      (*c.mutable_driver_scalars())[probe_schedule_key(I.probes->name(k))] =
           static_cast<double>(I.probe_schedules[k].next);
     for (const auto& m : tree_.roots) {
       StateRecord state;
@@ -320,11 +327,25 @@ RunSummary Simulation::run() {
     };
     I.checkpoint.next = static_cast<unsigned long long>(scalar("next_checkpoint"));
     I.output_index = static_cast<unsigned long long>(scalar("output_index"));
-    for (std::size_t k = 0; k < I.probe_schedules.size(); ++k)
-      I.probe_schedules[k].next =
-          static_cast<unsigned long long>(scalar("probe_next_" + std::to_string(k)));
+    for (std::size_t k = 0; k < I.probe_schedules.size(); ++k) {
+      Schedule& ps = I.probe_schedules[k];
+      const auto it = c.driver_scalars().find(probe_schedule_key(I.probes->name(k)));
+      if (it != c.driver_scalars().end()) {
+        ps.next = static_cast<unsigned long long>(it->second);
+      } else {
+        // A probe the checkpointed run did not have starts at its first sampling time after
+        // the restart (on the output grid when it has no interval of its own).
+        const double interval = ps.active() ? ps.interval : I.output.interval;
+        ps.next = interval > 0.0 ? static_cast<unsigned long long>(
+                                       std::floor(I.time / interval * (1.0 + 1e-12) + 1e-12)) +
+                                       1
+                                 : 0;
+      }
+    }
     restarted = true;
   }
+  if (files) I.probes->open_files(restarted ? std::optional<double>(I.time) : std::nullopt);
+  I.resume_time = restarted ? std::optional<double>(I.time) : std::nullopt;
 
   const double start_time = I.time;
   const unsigned long long start_steps = I.steps;
@@ -405,7 +426,8 @@ RunSummary Simulation::run() {
       std::cerr << line.str() << "\n";
   };
 
-  while (I.time < end - tolerance) {
+  while (I.time < end - tolerance &&
+         (options_.max_steps == 0 || I.steps - start_steps < options_.max_steps)) {
     double target = end;
     if (I.output.active()) target = std::min(target, I.output.time());
     if (I.checkpoint.active() && files) target = std::min(target, I.checkpoint.time());

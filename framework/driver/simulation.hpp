@@ -16,13 +16,14 @@
 namespace cosph {
 
 struct RunOptions {
-  int threads = 0;               // 0: the scene's run.threads, else all cores
-  std::string restart_file;      // continue from this checkpoint
-  std::string output_directory;  // overrides output.directory
-  bool bench = false;            // no files at all: steps and throughput only
-  bool progress = true;          // progress line on stderr
-  double end_time = -1.0;        // < 0: the scene's end_time (tests stop early with it)
-  bool health = true;            // run the health monitor (every run.health_interval steps)
+  int threads = 0;                   // 0: the scene's run.threads, else all cores
+  std::string restart_file;          // continue from this checkpoint
+  std::string output_directory;      // overrides output.directory
+  bool bench = false;                // no files at all: steps and throughput only
+  bool progress = true;              // progress line on stderr
+  double end_time = -1.0;            // < 0: the scene's end_time (tests stop early with it)
+  unsigned long long max_steps = 0;  // > 0: stop after this many steps (smoke runs), as at the end
+  bool health = true;                // run the health monitor (every run.health_interval steps)
 };
 
 struct ModuleTiming {

@@ -15,6 +15,11 @@ class CsvTimeSeries {
   // naming the path if the file cannot be opened.
   CsvTimeSeries(std::string path, std::vector<std::string> columns);
 
+  // Continues the series of a run restarted at `time`: where `path` holds this header, its rows
+  // up to `time` stay (later ones belong to the part of the run that is done again) and new
+  // rows follow them; otherwise (no file, another header) the file starts as above.
+  static CsvTimeSeries resume(std::string path, std::vector<std::string> columns, double time);
+
   // Writes one row "time,values..." with each number in its shortest exact (round-trip) form and
   // flushes it. values.size() must equal columns().size() (std::invalid_argument otherwise).
   // Throws cosph::RuntimeError naming the path if the write fails.
@@ -24,6 +29,8 @@ class CsvTimeSeries {
   const std::vector<std::string>& columns() const { return columns_; }
 
  private:
+  CsvTimeSeries(std::string path, std::vector<std::string> columns, const std::string& kept_rows);
+  static std::string header_of(const std::vector<std::string>& columns);
   void check_stream() const;
 
   std::string path_;

@@ -2,6 +2,7 @@
 // ParaView opens the whole time series as one data set with a time slider.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,11 @@ class PvdCollection {
   // Does not touch the file: it is (re)written by the first add(), so a collection constructed
   // for a run that then fails before any output leaves a previous run's file alone.
   explicit PvdCollection(std::string path);
+
+  // The collection of a run restarted at `time`: the entries of the file at `path` (as this
+  // class writes them) up to `time` stay, later ones are dropped (that part of the run is done
+  // again and rewrites their files). No file, or one this class did not write: a new collection.
+  static std::unique_ptr<PvdCollection> resume(std::string path, double time);
 
   // Appends one output time and rewrites the whole file atomically, so that a run stopped
   // midway (or still running) leaves a complete, valid collection. `file` is stored as given,

@@ -3,6 +3,7 @@
 
 #include <charconv>
 #include <string>
+#include <utility>
 
 namespace cosph {
 
@@ -40,6 +41,27 @@ inline std::string xml_escape(const std::string& text) {
       default:
         out += c;
     }
+  }
+  return out;
+}
+
+// The inverse of xml_escape (its five entities; anything else is kept as it is).
+inline std::string xml_unescape(const std::string& text) {
+  static const std::pair<const char*, char> entities[] = {
+      {"&amp;", '&'}, {"&lt;", '<'}, {"&gt;", '>'}, {"&quot;", '"'}, {"&apos;", '\''}};
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    bool replaced = false;
+    if (text[i] == '&')
+      for (const auto& [entity, c] : entities)
+        if (text.compare(i, std::char_traits<char>::length(entity), entity) == 0) {
+          out += c;
+          i += std::char_traits<char>::length(entity);
+          replaced = true;
+          break;
+        }
+    if (!replaced) out += text[i++];
   }
   return out;
 }

@@ -1,5 +1,7 @@
 #include "monodomain/ionic_model.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace cosph {
@@ -31,6 +33,19 @@ std::unique_ptr<IonicModel> make_ionic_model(const proto::IonicModelSpec& spec) 
   }
   throw std::invalid_argument(
       "an ionic model needs one of: fitzhugh_nagumo, aliev_panfilov, preset");
+}
+
+double reaction_step_limit(const IonicModel& model) {
+  double steepest = 0.0;
+  const int samples = 200;
+  const double dv = 1e-6;
+  for (int k = 0; k <= samples; ++k) {
+    const double V = double(k) / samples;
+    const double slope =
+        (model.voltage(V + dv, 0.0).production - model.voltage(V - dv, 0.0).production) / (2 * dv);
+    steepest = std::max(steepest, std::abs(slope));
+  }
+  return steepest > 0.0 ? 1.0 / steepest : INFINITY;
 }
 
 }  // namespace cosph

@@ -117,6 +117,7 @@ class MonodomainModule final : public StaticBodyModule<D> {
       throw RuntimeError("module '" + name_ + "': " + e.what());
     }
     max_dt_ = spec_.has_time_step() ? spec_.time_step() : diffusion_.stable_dt();
+    reaction_limit_ = reaction_step_limit(*model_);
     previous_.resize(x.size());
     update_derived();
   }
@@ -127,18 +128,22 @@ class MonodomainModule final : public StaticBodyModule<D> {
     auto& V = particles_.scalar("voltage");
     auto& w = particles_.scalar("gate");
     auto& activation = particles_.scalar("activation_time");
-    const double half = 0.5 * dt, threshold = spec_.activation_threshold();
+    const double threshold = spec_.activation_threshold();
+    // Each reaction half step in equal sub-steps no longer than the model's limit (one where
+    // the diffusion limit is the shorter, as in every example).
+    const int cuts = std::max(1, static_cast<int>(std::ceil(0.5 * dt / reaction_limit_)));
+    const double half = 0.5 * dt / cuts;
     const double t_end = time_ + dt;
     // Three passes: the first reaction half steps (local), the diffusion rate (gather), then the
     // diffusion update fused with the second reaction half steps and the activation record.
     parallel_for_each_index(V.size(), [&](std::size_t i) {
       previous_[i] = V[i];
-      react_before_diffusion(*model_, V[i], w[i], half);
+      for (int k = 0; k < cuts; ++k) react_before_diffusion(*model_, V[i], w[i], half);
     });
     const std::vector<double>& rate = diffusion_.rate(V);
     parallel_for_each_index(V.size(), [&](std::size_t i) {
       V[i] += dt * rate[i];
-      react_after_diffusion(*model_, V[i], w[i], half);
+      for (int k = 0; k < cuts; ++k) react_after_diffusion(*model_, V[i], w[i], half);
       // Activation time: the first upward crossing of the threshold, interpolated in time.
       if (activation[i] < 0.0 && V[i] >= threshold) {
         const double before = previous_[i];
@@ -237,6 +242,7 @@ class MonodomainModule final : public StaticBodyModule<D> {
   std::vector<Stimulus> stimuli_;
   std::vector<double> previous_;
   double max_dt_ = 0.0;
+  double reaction_limit_ = INFINITY;  // reaction_step_limit(*model_)
 };
 
 }  // namespace

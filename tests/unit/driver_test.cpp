@@ -156,6 +156,57 @@ TEST(Driver, OutputFilesAreWritten) {
   EXPECT_EQ(rows, 5);  // t = 0, 0.5, 1, 1.5, 2
 }
 
+std::string file_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Probe schedules are kept by name: a restart whose scene lists the probes in another order
+// (and adds one) samples each probe on its own grid, so that the files continue as if the run
+// had not stopped; the new probe starts at its first sampling time after the restart. Before,
+// schedules were stored by position and the swapped probes took each other's.
+TEST(Driver, RestartWithReorderedProbesKeepsEachProbesSchedule) {
+  const fs::path dir = temp_dir("reordered");
+  std::string text = kScene;
+  text.replace(text.find("  - name: point\n"), 16, "  - name: point\n    interval: 0.1\n");
+  text.replace(text.find("  - name: total\n"), 16, "  - name: total\n    interval: 0.25\n");
+  const std::string scene = write_scene(dir, text);
+  RunOptions full;
+  full.output_directory = (dir / "full").string();
+  final_field(scene, full);
+
+  RunOptions crashed;
+  crashed.output_directory = (dir / "crashed").string();
+  crashed.end_time = 1.3;  // stops after its checkpoint at t = 1
+  final_field(scene, crashed);
+  // The restarted scene: the two probes swapped, a third one added.
+  const std::string point = "  - name: point\n    interval: 0.1\n";
+  const std::size_t at = text.find(point);
+  std::string reordered = text.substr(0, at);
+  const std::string rest = text.substr(at + point.size());
+  const std::size_t body_end = rest.find("  - name: total");
+  reordered += rest.substr(body_end) + point + rest.substr(0, body_end) +
+               "  - name: late\n    interval: 0.3\n    reduce: {quantity: maximum, field: "
+               "concentration}\n";
+  RunOptions restart;
+  restart.output_directory = crashed.output_directory;
+  restart.restart_file = (dir / "crashed" / "checkpoint_000001.ckpt").string();
+  final_field(write_scene(temp_dir("reordered_scene"), reordered), restart);
+
+  for (const char* f : {"point.csv", "total.csv"})
+    EXPECT_EQ(file_text(dir / "crashed" / f), file_text(dir / "full" / f)) << f;
+  std::ifstream late(dir / "crashed" / "late.csv");
+  std::string header;
+  std::getline(late, header);
+  std::vector<double> times;
+  for (std::string line; std::getline(late, line);) times.push_back(std::stod(line));
+  const std::vector<double> expected = {1.2, 1.5, 1.8, 2.0};  // sampled at the step reaching them
+  ASSERT_EQ(times.size(), expected.size());
+  for (std::size_t k = 0; k < times.size(); ++k) EXPECT_NEAR(times[k], expected[k], 1e-9);
+}
+
 int cli(const std::vector<std::string>& args, std::string* err_text = nullptr) {
   std::ostringstream out, err;
   const int code = run_cli(args, out, err);
@@ -209,6 +260,20 @@ TEST(CommandLine, ExitCodesAndMessages) {
       cli({"run", scene, "--bench", "--quiet", "--restart", (dir / "nope.ckpt").string()}, &err),
       1);
   EXPECT_NE(err.find("nope.ckpt: cannot open"), std::string::npos) << err;
+  // --steps: a positive integer; the run stops after that many steps, before its end time.
+  EXPECT_EQ(cli({"run", scene, "--steps", "0"}, &err), 2);
+  EXPECT_NE(err.find("--steps expects a positive integer"), std::string::npos) << err;
+  EXPECT_EQ(cli({"run", scene, "--steps", "2.5"}, &err), 2);
+  RunOptions few;
+  few.bench = true;
+  few.progress = false;
+  few.max_steps = 3;
+  Simulation simulation(load_scene_file(scene), builtin_modules(), few);
+  simulation.initialize();
+  const RunSummary summary = simulation.run();
+  EXPECT_EQ(summary.steps, 3u);
+  EXPECT_GT(summary.end_time, 0.0);
+  EXPECT_LT(summary.end_time, 0.5);
 }
 
 }  // namespace

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <random>
 
 namespace cosph {
@@ -112,6 +114,41 @@ TEST(IonicModel, StrangQssSingleCellConvergesWithFirstOrder) {
   EXPECT_GT(e1 / e2, 1.8);
   EXPECT_GT(e2 / e3, 1.8);
   EXPECT_LT(e3, 1e-3);
+}
+
+// The reaction's step limit is 1 / max |dq/dV| over V in [0, 1]: for FitzHugh-Nagumo's table 2
+// the slope -3 V^2 + 2 (a + 1) V is steepest at V = 1 (|-0.8|), for Aliev-Panfilov's table 1 the
+// slope k (-3 V^2 + 2 (a + 1) V) likewise (|-5.6|).
+TEST(IonicModel, ReactionStepLimitIsTheInverseOfTheSteepestProductionSlope) {
+  EXPECT_NEAR(reaction_step_limit(FitzHughNagumo(proto::FitzHughNagumoSpec())), 1.0 / 0.8, 1e-6);
+  EXPECT_NEAR(reaction_step_limit(AlievPanfilov(proto::AlievPanfilovSpec())), 1.0 / 5.6, 1e-7);
+}
+
+// Why it exists: an excited FitzHugh-Nagumo cell stepped at dt = 16.7 (the diffusion limit at
+// spacing 0.1 with D = 1e-4) runs away in whole half steps, and stays on its action potential
+// when each half step is cut to the limit (7 sub-steps of 1.19).
+TEST(IonicModel, CutReactionStepsKeepACoarseStepOnTheActionPotential) {
+  const FitzHughNagumo model{proto::FitzHughNagumoSpec()};
+  const double dt = 16.7, limit = reaction_step_limit(model);
+  auto run = [&](int cuts) {
+    double V = 0.3, w = 0.0, peak = 0.0;
+    for (int step = 0; step < 60 && std::isfinite(V); ++step) {
+      for (int k = 0; k < cuts; ++k) react_before_diffusion(model, V, w, 0.5 * dt / cuts);
+      for (int k = 0; k < cuts; ++k) react_after_diffusion(model, V, w, 0.5 * dt / cuts);
+      peak = std::max(peak, std::abs(V));
+    }
+    return std::pair{V, peak};
+  };
+  const auto whole = run(1);
+  EXPECT_TRUE(!std::isfinite(whole.first) || whole.second > 2.0) << whole.second;
+  const int cuts = static_cast<int>(std::ceil(0.5 * dt / limit));
+  EXPECT_EQ(cuts, 7);
+  const auto [V, peak] = run(cuts);
+  std::cout << "dt 16.7: whole half steps peak |V| " << whole.second << ", cut " << peak
+            << ", V after 1002 " << V << "\n";
+  EXPECT_GT(peak, 0.9);         // it fires
+  EXPECT_LT(peak, 1.05);        // and does not overshoot
+  EXPECT_LT(std::abs(V), 0.3);  // and recovers
 }
 
 }  // namespace
