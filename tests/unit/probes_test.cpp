@@ -7,9 +7,11 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -19,6 +21,7 @@
 #include "core/particles.hpp"
 #include "io/csv_time_series.hpp"
 #include "io/reductions.hpp"
+#include "io/text_format.hpp"
 #include "kernels/kernel.hpp"
 #include "neighbour/domain.hpp"
 
@@ -485,8 +488,17 @@ TEST(CsvTimeSeries, HeaderAndRowsReadableWhileOpen) {
               "time,kinetic_energy,c@inlet,\"a,b\",\"say \"\"hi\"\"\"\n"
               "0,1,-2.5,0,3\n"
               "0.1,0.3333333333333333,nan,1e-300,-0\n");
-    // Full precision: the text reads back to the same double.
-    EXPECT_EQ(std::stod("0.3333333333333333"), 1.0 / 3.0);
+    // Full precision: what the series writes reads back to the same double, for any bit pattern
+    // of a finite double (normal, subnormal, signed zero), not only the ones above.
+    std::mt19937_64 bits(7);
+    for (int k = 0; k < 20000; ++k) {
+      const double x = std::bit_cast<double>(bits());
+      if (!std::isfinite(x)) continue;
+      const std::string text = format_double(x);
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(std::strtod(text.c_str(), nullptr)),
+                std::bit_cast<std::uint64_t>(x))
+          << text;
+    }
     EXPECT_THROW(csv.append(0.2, {1.0}), std::invalid_argument);
   }
   fs::remove(path);

@@ -239,11 +239,16 @@ TEST(FluidValidation, CylinderSheddingAtRe100MatchesTheBenchmark) {
   const double strouhal = best_f * 0.1;
   std::cout << "cylinder, D/10: St " << strouhal << " (0.295-0.305), mean C_D " << mean_drag
             << " (largest 3.22-3.24), C_L amplitude " << best_amplitude << " (0.99-1.01)\n";
-  EXPECT_NEAR(strouhal, 0.30, 0.12 * 0.30);  // measured 0.272
-  // The mean drag against the published largest value: the drag varies by ~1% over a cycle.
-  EXPECT_NEAR(mean_drag, 3.23, 0.15 * 3.23);  // measured 3.56
-  EXPECT_GT(best_amplitude, 0.4);             // measured 0.60: the street has formed
-  EXPECT_LT(best_amplitude, 1.3);
+  // D/10 is coarse: St 10% low, the drag 7% high and the lift amplitude 40% low against the
+  // benchmark, each converging towards it (D/20 in the study: 0.293, 3.35, 0.86). Bounded on
+  // both sides around the measured values: St 0.269, mean C_D 3.45594 (against the published
+  // largest value; the drag varies by ~1% over a cycle), C_L amplitude 0.59522.
+  EXPECT_GT(strouhal, 0.262);
+  EXPECT_LT(strouhal, 0.276);
+  EXPECT_GT(mean_drag, 3.36);
+  EXPECT_LT(mean_drag, 3.56);
+  EXPECT_GT(best_amplitude, 0.55);
+  EXPECT_LT(best_amplitude, 0.64);
 }
 
 }  // namespace

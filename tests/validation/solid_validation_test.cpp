@@ -102,8 +102,11 @@ TEST(SolidValidation, BendingCantileverSwingsWithTheFirstModePeriod) {
   ASSERT_GE(crossings.size(), 2u);
   const double period = crossings[1] - crossings[0];
   std::cout << "cantilever period " << period << " s (Euler-Bernoulli 1.79 s)\n";
-  // Measured 1.90 s: the swing is large (tip 4 m sideways), which lengthens the period.
-  EXPECT_NEAR(period, 1.79, 0.15 * 1.79);
+  // Measured 1.90455 s, 6.4% above the small-amplitude Euler-Bernoulli period: the swing is
+  // large (tip 4 m sideways), which lengthens it. No large-amplitude reference: bounded on both
+  // sides around the measured value (a stiffness off by 10% moves it by 5%).
+  EXPECT_GT(period, 1.87);
+  EXPECT_LT(period, 1.94);
 }
 
 }  // namespace
