@@ -1,5 +1,6 @@
 #include "fluid_wcsph/fluid_module.hpp"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -104,7 +105,12 @@ class FluidModule final : public Module {
     auto& volume = fluid_.add_scalar("volume");
     fluid_.add_scalar("density_rate", {.checkpoint = true});
     fluid_.add_vector("acceleration");
-    if (has_output("vorticity")) fluid_.add_scalar("vorticity", {.output = true});
+    if (has_output("vorticity")) {
+      if constexpr (D == 2)
+        fluid_.add_scalar("vorticity", {.output = true});
+      else
+        fluid_.add_vector("vorticity", {.output = true});
+    }
     const double rho0 = spec_.density(), c2 = sound_speed_ * sound_speed_;
     for (std::size_t i = 0; i < n; ++i) {
       x[i] = domain_.any_periodic() ? domain_.wrap(cloud.positions[i]) : cloud.positions[i];
@@ -185,25 +191,38 @@ class FluidModule final : public Module {
 
   void prepare_output() override {
     if (walls_.particles.has("force")) walls_.particles.vector("force") = recorded_force(walls_);
-    if (!fluid_.has("vorticity")) return;
-    if constexpr (D == 2) {
-      const auto& x = fluid_.vector("position");
-      const auto& v = fluid_.vector("velocity");
-      const auto& volume = fluid_.scalar("volume");
-      auto& w = fluid_.scalar("vorticity");
-      const CellLinkedList<D> cells(x, kernel_.support_radius(), domain_);
-      parallel_for_each_index(x.size(), [&](std::size_t i) {
-        double sum = 0.0;
-        cells.for_each_neighbour(x[i], kernel_.support_radius(), Index(i), [&](Index j) {
-          const Vec<D> d = domain_.displacement(x[i], x[j]);
-          const double r = d.norm();
-          const Vec<D> grad = kernel_.derivative(r) / r * d;  // grad_i W_ij
-          const Vec<D> dv = v[j] - v[i];
-          sum += volume[j] * (dv[1] * grad[0] - dv[0] * grad[1]);
-        });
-        w[i] = -sum;  // omega = dv_y/dx - dv_x/dy
+    if (fluid_.has("vorticity")) update_vorticity();
+  }
+
+  // The curl of the corrected velocity gradient grad v_i = G_i M_i^-1, with
+  // G_i = sum_j V_j (v_j - v_i) (x) grad_i W_ij and M_i = sum_j V_j (x_j - x_i) (x) grad_i W_ij
+  // (exact for linear velocity fields wherever M_i is invertible, the free surface included;
+  // uncorrected, the bulk read 2.6% low at h = 1.3 dp). A particle whose neighbours do not span
+  // the space (a lone drop: det M_i below 1e-3 of the full support's 1) keeps G_i alone. 2D: the
+  // scalar dv_y/dx - dv_x/dy; 3D: the vector.
+  void update_vorticity() {
+    const auto& x = fluid_.vector("position");
+    const auto& v = fluid_.vector("velocity");
+    const auto& volume = fluid_.scalar("volume");
+    const CellLinkedList<D> cells(x, kernel_.support_radius(), domain_);
+    parallel_for_each_index(x.size(), [&](std::size_t i) {
+      Mat<D> G = Mat<D>::Zero(), M = Mat<D>::Zero();
+      cells.for_each_neighbour(x[i], kernel_.support_radius(), Index(i), [&](Index j) {
+        const Vec<D> d = domain_.displacement(x[i], x[j]);  // x_i - x_j
+        const double r = d.norm();
+        if (!(r > 0.0)) return;
+        const Vec<D> grad = kernel_.derivative(r) / r * d;  // grad_i W_ij
+        G.noalias() += volume[j] * (v[j] - v[i]) * grad.transpose();
+        M.noalias() -= volume[j] * d * grad.transpose();
       });
-    }
+      const Mat<D> L = std::abs(M.determinant()) > 1e-3 ? Mat<D>(G * M.inverse()) : G;
+      if constexpr (D == 2) {
+        fluid_.scalar("vorticity")[i] = L(1, 0) - L(0, 1);
+      } else {
+        fluid_.vector("vorticity")[i] =
+            Vec<3>(L(2, 1) - L(1, 2), L(0, 2) - L(2, 0), L(1, 0) - L(0, 1));
+      }
+    });
   }
 
   // The force of the fluid on each contact particle in its last acoustic sub-step (pressure) and

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -36,6 +37,9 @@ class SolidModule final : public StaticBodyModule<D> {
         material_(spec_.material(), key_ + ".material") {
     if (spec_.has_active_tension())
       active_tension_ = parse(spec_.active_tension(), key_ + ".active_tension");
+    if (D == 2 && std::find(spec_.outputs().begin(), spec_.outputs().end(), "von_mises") !=
+                      spec_.outputs().end())
+      plane_strain_.emplace(spec_.material(), key_ + ".material");
     for (int a = 0; a < spec_.initial_velocity_size(); ++a)
       initial_velocity_.push_back(
           parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));
@@ -189,7 +193,7 @@ class SolidModule final : public StaticBodyModule<D> {
       if (vm || stress) {
         const Mat<D> sigma = first_piola(i, F_[i], frame) * F_[i].transpose() / J[i];
         if (stress) particles_.matrix("stress")[i] = sigma;
-        if (vm) particles_.scalar("von_mises")[i] = von_mises(sigma);
+        if (vm) particles_.scalar("von_mises")[i] = von_mises(sigma, out_of_plane_stress(i));
       }
       if (energy) particles_.scalar("strain_energy")[i] = material_.energy(F_[i], frame);
       if (fibre) {
@@ -363,9 +367,24 @@ class SolidModule final : public StaticBodyModule<D> {
     return ramp > 0.0 ? std::min(t / ramp, 1.0) : 1.0;
   }
 
-  static double von_mises(const Mat<D>& s) {
+  // sigma_zz of particle i in plane strain (2D; 0 in 3D, where sigma is whole): the 3D law at
+  // F3 = diag(F, 1), sigma_zz = P3_zz / J. The active tension acts in the plane (f0 has no z).
+  double out_of_plane_stress(std::size_t i) const {
+    if constexpr (D == 2) {
+      Mat<3> F3 = Mat<3>::Identity(), frame3 = Mat<3>::Identity();
+      F3.topLeftCorner<2, 2>() = F_[i];
+      if (has_frames()) frame3.topLeftCorner<2, 2>() = frames_[i];
+      return plane_strain_->stress(F3, frame3)(2, 2) / F_[i].determinant();
+    } else {
+      (void)i;
+      return 0.0;
+    }
+  }
+
+  static double von_mises(const Mat<D>& s, double s_zz) {
     Mat<3> full = Mat<3>::Zero();
     full.template topLeftCorner<D, D>() = s;
+    if constexpr (D == 2) full(2, 2) = s_zz;
     const Mat<3> dev = full - full.trace() / 3.0 * Mat<3>::Identity();
     return std::sqrt(1.5 * (dev.array() * dev.array()).sum());
   }
@@ -681,6 +700,9 @@ class SolidModule final : public StaticBodyModule<D> {
 
   proto::SolidSpec spec_;
   MaterialModel<D> material_;
+  // 2D is plane strain: the out-of-plane stress sigma_zz that holds F_zz = 1 enters the von Mises
+  // stress. The same law in 3D gives it (built only when von Mises is asked for, in 2D).
+  std::optional<MaterialModel<3>> plane_strain_;
   Expression active_tension_;
   std::vector<Expression> initial_velocity_;
   std::vector<Vec<D>> X_, x_;
