@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "driver/state_reader.hpp"
 
 namespace cosph {
 namespace {
@@ -93,6 +94,13 @@ class FsiCoupler final : public Coupler {
       if (!(solid_dt > 0.0) || !std::isfinite(solid_dt))
         throw RuntimeError("FSI coupler: the solid's stable step is " + std::to_string(solid_dt) +
                            " at t = " + std::to_string(fluid().time()));
+      // Thousands of sub-steps per acoustic step are normal for stiff gates (measured up to
+      // ~400); a million means a broken state (a restored step limit gone wrong), not physics.
+      if (!(dt / solid_dt < kMaxSubsteps))
+        throw RuntimeError("FSI coupler: the solid's stable step " + std::to_string(solid_dt) +
+                           " would take more than " + std::to_string(long(kMaxSubsteps)) +
+                           " sub-steps of the fluid's acoustic step " + std::to_string(dt) +
+                           " at t = " + std::to_string(fluid().time()));
       const long long kappa = static_cast<long long>(std::floor(dt / solid_dt)) + 1;
       for (long long k = 0; k < kappa; ++k) solid().advance(dt / double(kappa));
       solid().write(particles_port_, after_);
@@ -145,10 +153,12 @@ class FsiCoupler final : public Coupler {
   }
 
   void load_own(const StateRecord& state) override {
-    velocity_average_ = state.arrays.at("velocity_average");
-    acceleration_average_ = state.arrays.at("acceleration_average");
-    acoustic_steps_ = state.integers.at("acoustic_steps");
-    solid_substeps_ = state.integers.at("solid_substeps");
+    const StateReader read(state, "coupler '" + info().name + "'");
+    const std::size_t values = velocity_average_.size();  // the solid's interface, built by connect
+    velocity_average_ = read.array("velocity_average", values);
+    acceleration_average_ = read.array("acceleration_average", values);
+    acoustic_steps_ = read.integer("acoustic_steps");
+    solid_substeps_ = read.integer("solid_substeps");
   }
 
  private:
@@ -189,6 +199,7 @@ class FsiCoupler final : public Coupler {
   bool solid_acceleration_in_pressure_ = false;
   double resolution_ratio_ = 1.0;
   FieldBuffer before_, after_, force_, contact_;
+  static constexpr double kMaxSubsteps = 1e6;
   std::vector<double> velocity_average_, acceleration_average_;
   long long acoustic_steps_ = 0, solid_substeps_ = 0;
 };

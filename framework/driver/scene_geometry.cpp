@@ -138,8 +138,15 @@ Kernel build_kernel(const proto::BodySpec& body, int dimension) {
 }
 
 template <int D>
-void check_inside_domain(const proto::Scene& scene, const ParticleCloud<D>& cloud,
-                         const std::string& key_path) {
+void check_body_cloud(const proto::Scene& scene, const ParticleCloud<D>& cloud,
+                      const std::string& key_path) {
+  if (static_cast<double>(cloud.positions.size()) > scene.run().max_particles()) {
+    std::ostringstream msg;
+    msg << cloud.positions.size()
+        << " particles, more than run.max_particles = " << scene.run().max_particles()
+        << " (is the spacing in the geometry's unit? raise run.max_particles for a run this large)";
+    throw ConfigError(key_path, msg.str());
+  }
   if (!scene.has_domain()) return;
   const Domain<D> domain = build_domain<D>(scene);
   for (std::size_t i = 0; i < cloud.positions.size(); ++i) {
@@ -158,7 +165,7 @@ void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
                        const std::string& key_path, const std::string& scene_directory,
                        const Kernel& kernel, ParticleSet<D>& particles) {
   const ParticleCloud<D> cloud = build_body<D>(spec, key_path, scene_directory);
-  check_inside_domain<D>(scene, cloud, key_path);
+  check_body_cloud<D>(scene, cloud, key_path);
   const Domain<D> domain = build_domain<D>(scene);
   const auto order = cell_sort_order<D>(cloud.positions, kernel.support_radius(), domain);
   particles.resize(cloud.positions.size());
@@ -177,8 +184,8 @@ void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
   template ParticleCloud<D> build_body<D>(const proto::BodySpec&, const std::string&,       \
                                           const std::string&);                              \
   template Domain<D> build_domain<D>(const proto::Scene&);                                  \
-  template void check_inside_domain<D>(const proto::Scene&, const ParticleCloud<D>&,        \
-                                       const std::string&);                                 \
+  template void check_body_cloud<D>(const proto::Scene&, const ParticleCloud<D>&,           \
+                                    const std::string&);                                    \
   template void build_static_body<D>(const proto::Scene&, const proto::BodySpec&,           \
                                      const std::string&, const std::string&, const Kernel&, \
                                      ParticleSet<D>&);

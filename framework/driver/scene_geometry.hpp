@@ -29,10 +29,11 @@ Domain<D> build_domain(const proto::Scene& scene);
 
 Kernel build_kernel(const proto::BodySpec& body, int dimension);
 
-// Throws ConfigError if any position lies outside the scene's domain (when one is given).
+// Throws ConfigError at key_path if the cloud has more particles than run.max_particles or any
+// position lies outside the scene's domain (when one is given).
 template <int D>
-void check_inside_domain(const proto::Scene& scene, const ParticleCloud<D>& cloud,
-                         const std::string& key_path);
+void check_body_cloud(const proto::Scene& scene, const ParticleCloud<D>& cloud,
+                      const std::string& key_path);
 
 // Particles that never move (diffusion, monodomain): the body's cloud checked against the domain,
 // sorted by cell once for memory locality, wrapped into periodic axes, with the fields "position"

@@ -318,20 +318,30 @@ RunSummary Simulation::run() {
                            "'");
       roots[k]->load(decode_state(ms));
     }
+    if (!(std::isfinite(c.time()) && c.time() >= 0.0))
+      throw RuntimeError(options_.restart_file + ": checkpoint time " + json_number(c.time()) +
+                         " is not a time");
     I.time = c.time();
     I.steps = c.step();
     I.output.next = c.next_output();
+    // Schedule indices are stored as doubles: whole, non-negative and exact, or refused.
+    auto index = [&](const std::string& key, double value) {
+      if (!(value >= 0.0 && value <= 9007199254740992.0 && value == std::floor(value)))
+        throw RuntimeError(options_.restart_file + ": checkpoint's " + key + " = " +
+                           json_number(value) + " is not a schedule index");
+      return static_cast<unsigned long long>(value);
+    };
     auto scalar = [&](const std::string& key) {
       auto it = c.driver_scalars().find(key);
-      return it == c.driver_scalars().end() ? 0.0 : it->second;
+      return index(key, it == c.driver_scalars().end() ? 0.0 : it->second);
     };
-    I.checkpoint.next = static_cast<unsigned long long>(scalar("next_checkpoint"));
-    I.output_index = static_cast<unsigned long long>(scalar("output_index"));
+    I.checkpoint.next = scalar("next_checkpoint");
+    I.output_index = scalar("output_index");
     for (std::size_t k = 0; k < I.probe_schedules.size(); ++k) {
       Schedule& ps = I.probe_schedules[k];
       const auto it = c.driver_scalars().find(probe_schedule_key(I.probes->name(k)));
       if (it != c.driver_scalars().end()) {
-        ps.next = static_cast<unsigned long long>(it->second);
+        ps.next = index(it->first, it->second);
       } else {
         // A probe the checkpointed run did not have starts at its first sampling time after
         // the restart (on the output grid when it has no interval of its own).

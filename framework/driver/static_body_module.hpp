@@ -12,6 +12,7 @@
 #include "driver/module.hpp"
 #include "driver/registry.hpp"
 #include "driver/scene_geometry.hpp"
+#include "driver/state_reader.hpp"
 #include "expression/expression.hpp"
 
 namespace cosph {
@@ -75,15 +76,10 @@ class StaticBodyModule : public Module {
 
   // Loads them back, refusing a record of another size.
   void load_state(const StateRecord& state, const std::vector<std::string>& fields) {
-    for (const auto& f : fields) {
-      auto it = state.arrays.find(f);
-      if (it == state.arrays.end() || it->second.size() != particles_.size())
-        throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
-                           std::to_string(particles_.size()) + " values of '" + f + "'");
-      particles_.scalar(f) = it->second;
-    }
-    time_ = state.scalars.at("time");
-    steps_ = state.integers.at("steps");
+    const StateReader read(state, "module '" + name_ + "'");
+    for (const auto& f : fields) particles_.scalar(f) = read.array(f, particles_.size());
+    time_ = read.scalar("time");
+    steps_ = read.integer("steps");
   }
 
   // Copies one scalar field into a port buffer, or from one (checking its shape).

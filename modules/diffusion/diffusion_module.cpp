@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
+#include "driver/state_reader.hpp"
 #include "driver/static_body_module.hpp"
 #include "geometry/regions.hpp"
 #include "neighbour/cell_linked_list.hpp"
@@ -141,9 +142,10 @@ class DiffusionModule final : public StaticBodyModule<D> {
 
   void load(const StateRecord& state) override {
     Base::load_state(state, {spec_.field()});
-    lower_ = state.scalars.at("lower_bound");
-    upper_ = state.scalars.at("upper_bound");
-    initial_energy_ = state.scalars.at("initial_energy");
+    const StateReader read(state, "module '" + name_ + "'");
+    lower_ = read.scalar("lower_bound");
+    upper_ = read.scalar("upper_bound");
+    initial_energy_ = read.scalar("initial_energy");
   }
 
  private:

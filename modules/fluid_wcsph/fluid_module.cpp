@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "driver/scene_geometry.hpp"
+#include "driver/state_reader.hpp"
 #include "expression/expression.hpp"
 #include "fluid_wcsph/boundary_set.hpp"
 #include "fluid_wcsph/open_boundaries.hpp"
@@ -94,7 +95,7 @@ class FluidModule final : public Module {
 
   void initialize() override {
     const ParticleCloud<D> cloud = build_body<D>(spec_.body(), key_ + ".body", scene_directory_);
-    check_inside_domain<D>(scene_, cloud, key_ + ".body");
+    check_body_cloud<D>(scene_, cloud, key_ + ".body");
     const std::size_t n = cloud.positions.size();
     fluid_.resize(n);
     auto& x = fluid_.add_vector("position", {.output = true, .checkpoint = true});
@@ -337,9 +338,10 @@ class FluidModule final : public Module {
       }
       walls_.cells.reset();
     }
-    time_ = state.scalars.at("time");
-    steps_ = state.integers.at("steps");
-    acoustic_steps_ = state.integers.at("acoustic_steps");
+    const StateReader read(state, "module '" + name_ + "'");
+    time_ = read.scalar("time");
+    steps_ = read.integer("steps");
+    acoustic_steps_ = read.integer("acoustic_steps");
     update_pressure();
     update_volumes();
   }
@@ -440,7 +442,7 @@ class FluidModule final : public Module {
       } catch (const std::invalid_argument& e) {
         throw ConfigError(path + ".shape", e.what());
       }
-      check_inside_domain<D>(scene_, cloud, path + ".shape");
+      check_body_cloud<D>(scene_, cloud, path + ".shape");
       for (std::size_t i = 0; i < cloud.positions.size(); ++i) {
         x.push_back(cloud.positions[i]);
         volume.push_back(cloud.volumes[i]);

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
+#include "driver/state_reader.hpp"
 #include "driver/static_body_module.hpp"
 #include "geometry/regions.hpp"
 #include "geometry/surface.hpp"
@@ -299,15 +300,18 @@ class SolidModule final : public StaticBodyModule<D> {
                            std::to_string(raw.size()) + " values of '" + f + "'");
       std::copy(it->second.begin(), it->second.end(), raw.begin());
     }
-    auto it = state.arrays.find("active_tension");
-    if (it != state.arrays.end()) {
+    const StateReader read(state, "module '" + name_ + "'");
+    if (const auto* tension = read.optional_array("active_tension", particles_.size())) {
       if (!particles_.has("active_tension"))
         active_ = &particles_.add_scalar("active_tension", {.output = true, .checkpoint = true});
-      particles_.scalar("active_tension") = it->second;
+      particles_.scalar("active_tension") = *tension;
     }
-    time_ = state.scalars.at("time");
-    stiffness_eigenvalue_ = state.scalars.at("stiffness_eigenvalue");
-    steps_ = state.integers.at("steps");
+    time_ = read.scalar("time");
+    stiffness_eigenvalue_ = read.scalar("stiffness_eigenvalue");
+    if (!(std::isfinite(stiffness_eigenvalue_) && stiffness_eigenvalue_ >= 0.0))
+      throw RuntimeError("module '" + name_ + "': checkpoint's stiffness_eigenvalue " +
+                         std::to_string(stiffness_eigenvalue_) + " is not an eigenvalue");
+    steps_ = read.integer("steps");
     const auto& u = particles_.vector("displacement");
     auto& x = particles_.vector("position");
     for (std::size_t i = 0; i < u.size(); ++i) x[i] = X_[i] + u[i];

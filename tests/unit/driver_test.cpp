@@ -2,13 +2,16 @@
 // checkpoints are refused, and the command line maps errors to exit codes with clear messages.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "cli.hpp"
 #include "core/error.hpp"
 #include "driver/simulation.hpp"
+#include "io/checkpoint_file.hpp"
 #include "module_catalogue.hpp"
 
 namespace cosph {
@@ -54,6 +57,13 @@ std::string write_scene(const fs::path& dir, const std::string& text) {
   const fs::path file = dir / "scene.yaml";
   std::ofstream(file) << text;
   return file.string();
+}
+
+std::string file_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 std::vector<double> final_field(const std::string& scene, RunOptions options) {
@@ -136,6 +146,27 @@ TEST(Driver, DamagedOrForeignCheckpointIsRefused) {
   std::string other = kScene;
   other.replace(other.find("spacing: 0.025"), 14, "spacing: 0.05");
   refused(bytes, write_scene(temp_dir("damaged_other"), other), "another scene");
+  // Intact files whose records do not fit the module: a missing key, an array of another size,
+  // a schedule index that is no index. Each is named; none reads out of range.
+  auto edited = [&](const std::function<void(proto::Checkpoint&)>& edit) {
+    proto::Checkpoint c = read_checkpoint(good.string());
+    edit(c);
+    const fs::path file = dir / "edited.ckpt";
+    write_checkpoint(file.string(), c);
+    return file_text(file);
+  };
+  refused(edited([](proto::Checkpoint& c) {
+            c.mutable_modules(0)->mutable_integers()->erase("steps");
+          }),
+          scene, "module 'blob': checkpoint does not match: it has no integer 'steps'");
+  refused(edited([](proto::Checkpoint& c) {
+            c.mutable_modules(0)->mutable_arrays(0)->mutable_values()->RemoveLast();
+          }),
+          scene, "module 'blob': checkpoint does not match: expected");
+  refused(
+      edited([](proto::Checkpoint& c) { (*c.mutable_driver_scalars())["output_index"] = -3.5; }),
+      scene, "output_index = -3.5 is not a schedule index");
+  refused(edited([](proto::Checkpoint& c) { c.set_time(std::nan("")); }), scene, "is not a time");
 }
 
 TEST(Driver, OutputFilesAreWritten) {
@@ -154,13 +185,6 @@ TEST(Driver, OutputFilesAreWritten) {
   int rows = 0;
   for (std::string line; std::getline(csv, line);) ++rows;
   EXPECT_EQ(rows, 5);  // t = 0, 0.5, 1, 1.5, 2
-}
-
-std::string file_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // Probe schedules are kept by name: a restart whose scene lists the probes in another order
@@ -260,6 +284,12 @@ TEST(CommandLine, ExitCodesAndMessages) {
       cli({"run", scene, "--bench", "--quiet", "--restart", (dir / "nope.ckpt").string()}, &err),
       1);
   EXPECT_NE(err.find("nope.ckpt: cannot open"), std::string::npos) << err;
+  // A spacing far too fine for the geometry: stopped before the memory runs out, the body named.
+  EXPECT_EQ(cli({"check", scene, "--set", "run.max_particles=1000"}, &err), 2);
+  EXPECT_NE(err.find("modules[0].diffusion.body: 1488 particles, more than run.max_particles = "
+                     "1000"),
+            std::string::npos)
+      << err;
   // --steps: a positive integer; the run stops after that many steps, before its end time.
   EXPECT_EQ(cli({"run", scene, "--steps", "0"}, &err), 2);
   EXPECT_NE(err.find("--steps expects a positive integer"), std::string::npos) << err;
