@@ -43,8 +43,11 @@ TEST(FluidStability, DamBreakKeepsEveryParticleInTheTankThroughTheImpact) {
   }
   const auto [lo, hi] = std::minmax_element(rho.begin(), rho.end());
   std::cout << "density after 20 time units in [" << *lo << ", " << *hi << "] rho0\n";
-  EXPECT_GT(*lo, 0.95);
-  EXPECT_LT(*hi, 1.05);
+  // Measured [1.00003, 1.00125]: at rest the bottom of the spread layer (0.37 deep) sits at
+  // 1 + g h / c^2 = 1.0009; the band allows 1.5x the measured excess and nothing below rho0's
+  // 1 - 5e-4 (density reinitialisation keeps the free surface at rho0).
+  EXPECT_GT(*lo, 1.0 - 5e-4);
+  EXPECT_LT(*hi, 1.0 + 1.5 * 0.00125);
 }
 
 TEST(FluidStability, HydrostaticTankStaysStillForALongRun) {

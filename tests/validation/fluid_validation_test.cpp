@@ -71,8 +71,9 @@ TEST(FluidValidation, DamBreakImpactAndPlateauAtSensorsOneAndThreeMatchTheExperi
   const double plateau = mean_over(sensor, 3.5, 5.5), expected = mean_over(experiment, 3.5, 5.5);
   std::cout << "sensor 1: impact at " << impact << " (experiment " << measured
             << "), plateau p/(rho g H) " << plateau << " (experiment " << expected << ")\n";
-  EXPECT_NEAR(impact, measured, 0.35);              // measured 0.25 late at H/40, 0.11 at H/80
-  EXPECT_NEAR(plateau, expected, 0.25 * expected);  // the hydrostatic-like load after the impact
+  // Measured at H/40: impact 0.257 late (0.11 at H/80), plateau 0.732 against 0.671 (+9.2%).
+  EXPECT_NEAR(impact, measured, 0.35);
+  EXPECT_NEAR(plateau, expected, 0.14 * expected);  // the hydrostatic-like load after the impact
 
   // Sensor 3, 30 mm above the floor (0.1 H).
   const Series sensor3 = read_probe(options.output_directory + "/wall_pressure.csv", 3);
@@ -82,8 +83,8 @@ TEST(FluidValidation, DamBreakImpactAndPlateauAtSensorsOneAndThreeMatchTheExperi
                expected3 = mean_over(experiment3, 3.5, 5.5);
   std::cout << "sensor 3: impact at " << impact3 << " (experiment " << measured3
             << "), plateau p/(rho g H) " << plateau3 << " (experiment " << expected3 << ")\n";
-  EXPECT_NEAR(impact3, measured3, 0.3);                // measured 0.18 late at H/40
-  EXPECT_NEAR(plateau3, expected3, 0.15 * expected3);  // measured 4% low
+  EXPECT_NEAR(impact3, measured3, 0.26);               // measured 0.176 late at H/40
+  EXPECT_NEAR(plateau3, expected3, 0.09 * expected3);  // measured 6.1% low
 
   // The water level at gauge H1 (x = H), every time unit until the reflected wave returns.
   const Series gauge = read_probe(options.output_directory + "/gauge_H1.csv", 1);
@@ -96,7 +97,8 @@ TEST(FluidValidation, DamBreakImpactAndPlateauAtSensorsOneAndThreeMatchTheExperi
     };
     std::cout << "gauge H1 at t = " << t << ": " << at(gauge) << " (experiment " << at(level)
               << ")\n";
-    EXPECT_NEAR(at(gauge), at(level), 0.05);  // measured within 0.02 H
+    // Measured -0.0119, +0.0007, +0.0108, +0.0127 H at t = 1, 2, 3, 4.
+    EXPECT_NEAR(at(gauge), at(level), 0.019);
   }
 }
 
