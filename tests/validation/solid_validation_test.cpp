@@ -50,13 +50,15 @@ TEST(SolidValidation, OscillatingPlatePeriodApproachesLinearTheoryAndKeepsItsEne
   const double period = (crossings.back() - crossings.front()) / (crossings.size() - 1);
   const double theory = 0.2541;  // omega^2 = E H^2 k^4 / (12 rho (1 - nu^2)), kL = 1.875
   std::cout << "plate period " << period << " (linear theory " << theory << ")\n";
-  // Measured 0.2694 at H/dp = 10 (6.0% long) and 0.2600 at H/dp = 20 (2.3%): bench/studies.
-  EXPECT_GT(period, theory);
+  // Measured 0.269427 at H/dp = 10 (6.03% long) and 0.2600 at H/dp = 20 (2.3%): bench/studies.
+  // Converging from above: bounded on both sides of the measured 6%.
+  EXPECT_GT(period, 1.04 * theory);
   EXPECT_LT(period, 1.08 * theory);
   // Amplitude V_f c0 / omega = 0.01 * 57.03 / 24.73 = 0.02306.
   double amplitude = 0.0;
   for (double v : y) amplitude = std::max(amplitude, std::abs(v));
-  EXPECT_NEAR(amplitude, 0.02306, 0.1 * 0.02306);
+  std::cout << "plate amplitude " << amplitude << " (linear theory 0.02306)\n";
+  EXPECT_NEAR(amplitude, 0.02306, 0.07 * 0.02306);  // measured 0.0241357 (+4.7%)
 
   // Undamped, no artificial viscosity: position Verlet keeps kinetic + elastic energy.
   const auto kinetic = csv_column(dir + "/kinetic_energy.csv", 1);
@@ -69,7 +71,7 @@ TEST(SolidValidation, OscillatingPlatePeriodApproachesLinearTheoryAndKeepsItsEne
   }
   const double initial = kinetic[0] + elastic[0];
   std::cout << "energy band " << (hi - lo) / initial << " of the initial energy\n";
-  EXPECT_LT((hi - lo) / initial, 1e-4);  // measured 9.3e-6 over four periods
+  EXPECT_LT((hi - lo) / initial, 1.4e-5);  // measured 9.52e-6 over four periods
 }
 
 TEST(SolidValidation, LandBeamConvergesAtSecondOrderTo417Millimetres) {
@@ -88,7 +90,10 @@ TEST(SolidValidation, LandBeamConvergesAtSecondOrderTo417Millimetres) {
             << ", extrapolated " << extrapolated << " (reference 4.17)\n";
   EXPECT_LT(fine, coarse);  // converging from above (coarse TL-SPH is too soft in bending)
   EXPECT_GT(fine, 4.17);
-  EXPECT_NEAR(extrapolated, 4.17, 0.08);  // measured 4.17
+  // Measured 5.85392 and 4.91495 mm (+40%, +18%), extrapolated 4.16377 (-0.15%).
+  EXPECT_GT(fine, 4.85);
+  EXPECT_LT(fine, 4.98);
+  EXPECT_NEAR(extrapolated, 4.17, 0.01);
 }
 
 TEST(SolidValidation, BendingCantileverSwingsWithTheFirstModePeriod) {
