@@ -14,14 +14,16 @@ CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double c
                                   const Domain<D>& domain)
     : positions_(positions), domain_(domain), cell_size_(0.5 * cutoff) {
   if (!(cutoff > 0.0)) throw std::invalid_argument("cell-linked list: cut-off must be positive");
+  // The bounds of the finite positions: a non-finite one (a blown-up run, a damaged
+  // checkpoint, before the health monitor reports it) goes to cell 0 (cell_of_position) and
+  // must not make the grid's size NaN, whose conversion to a cell count is undefined.
   Vec<D> lo = Vec<D>::Constant(0.0), hi = Vec<D>::Constant(0.0);
-  if (!positions.empty()) {
-    lo = positions[0];
-    hi = positions[0];
-    for (const auto& x : positions) {
-      lo = lo.cwiseMin(x);
-      hi = hi.cwiseMax(x);
-    }
+  bool first = true;
+  for (const auto& x : positions) {
+    if (!x.allFinite()) continue;
+    lo = first ? x : Vec<D>(lo.cwiseMin(x));
+    hi = first ? x : Vec<D>(hi.cwiseMax(x));
+    first = false;
   }
   // Sparse clouds in a large box would create mostly empty cells: widen the cells so that there
   // are at most a few per particle (a wider cell is still correct, only less selective).

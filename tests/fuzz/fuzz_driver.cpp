@@ -88,7 +88,13 @@ const std::vector<std::string> kTokens = {": ",
                                           "modules:",
                                           "couplers:",
                                           "probes:",
-                                          "spacing: 1e-9"};
+                                          "spacing: 1e-9",
+                                          "\n#--set\n",
+                                          "modules[0].",
+                                          "=",
+                                          "end_time=",
+                                          "x,y,volume\n",
+                                          "1e999"};
 
 std::string mutate(const std::vector<std::string>& seeds, std::mt19937_64& rng) {
   auto pick = [&](std::size_t n) { return n == 0 ? std::size_t(0) : std::size_t(rng() % n); };

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -15,6 +16,7 @@
 #include "driver/coupler_registry.hpp"
 #include "driver/state_codec.hpp"
 #include "driver/timed_module.hpp"
+#include "io/checkpoint_file.hpp"
 #include "scene/scene_loader.hpp"
 
 namespace cosph {
@@ -226,6 +228,38 @@ TEST(FsiCoupler, RestartAndThreadsAreBitIdentical) {
   double moved = 0.0;
   for (const auto& v : full.gate_velocity) moved = std::max(moved, v.norm());
   EXPECT_GT(moved, 0.05);  // the gate is moving: the comparison compares something
+}
+
+// Regression (found by tests/fuzz/checkpoint_fuzz.cpp): a checkpoint whose solid record holds
+// a stiffness eigenvalue of 1e30 made the solid's step 1e-15 s, and the coupler ran 1e13 solid
+// sub-steps in one acoustic step: a hang. Such a checkpoint is refused with a message now, and a
+// NaN or negative eigenvalue is refused by the solid itself.
+TEST(FsiCoupler, CheckpointWithABrokenSolidStepIsRefused) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(testing::TempDir()) / "cosph_fsi_broken_checkpoint";
+  fs::remove_all(dir);
+  run_gate((dir / "full").string(), 1);
+  const fs::path checkpoint = dir / "full" / "checkpoint_000001.ckpt";
+  auto restart_with = [&](double eigenvalue) -> std::string {
+    proto::Checkpoint c = read_checkpoint(checkpoint.string());
+    proto::ModuleState* fsi = c.mutable_modules(0);
+    EXPECT_EQ(fsi->type(), "fsi");
+    proto::ModuleState* gate = fsi->mutable_children(1);
+    EXPECT_EQ(gate->name(), "gate");
+    (*gate->mutable_scalars())["stiffness_eigenvalue"] = eigenvalue;
+    const fs::path edited = dir / "edited.ckpt";
+    write_checkpoint(edited.string(), c);
+    try {
+      run_gate((dir / "restart").string(), 1, edited.string());
+    } catch (const RuntimeError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_NE(restart_with(1e30).find("would take more than 1000000 sub-steps"), std::string::npos);
+  EXPECT_NE(restart_with(std::nan("")).find("module 'gate': checkpoint's stiffness_eigenvalue"),
+            std::string::npos);
+  EXPECT_NE(restart_with(-1.0).find("is not an eigenvalue"), std::string::npos);
 }
 
 // ---- Scene errors ----------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <set>
 
@@ -88,6 +89,30 @@ TEST(NeighbourSearch, PeriodicAxisShorterThanThreeCutoffsIsRejected) {
   domain.periodic = {true, false};
   auto x = random_cloud<2>(50, domain.lower, domain.upper, 1);
   EXPECT_THROW(build_inner_list<2>(x, 0.1, domain), std::invalid_argument);
+}
+
+// Regression (found by the checkpoint fuzz target under UBSan): a NaN first position made the
+// grid's bounds NaN and its cell count an undefined conversion. Non-finite positions (a run
+// blowing up before the health monitor's next check) now have no neighbours and leave the list
+// of the finite ones as brute force gives it.
+TEST(NeighbourSearch, NonFinitePositionsDoNotBreakTheGrid) {
+  Domain<2> domain;
+  domain.upper = Vec<2>(1.0, 1.0);
+  auto x = random_cloud<2>(500, domain.lower, domain.upper, 3);
+  x[0] = Vec<2>(std::nan(""), 0.5);
+  x[1] = Vec<2>(INFINITY, -INFINITY);
+  const auto cells = build_inner_list<2>(x, 0.08, domain);
+  EXPECT_EQ(cells.of(0).size(), 0u);
+  EXPECT_EQ(cells.of(1).size(), 0u);
+  const std::vector<Vec<2>> finite(x.begin() + 2, x.end());
+  const auto brute = brute_force_list<2>(finite, finite, 0.08, domain, true);
+  for (std::size_t i = 2; i < x.size(); ++i) {
+    std::set<Index> got, want;
+    for (Index j : cells.of(i)) got.insert(j - 2);
+    for (Index j : brute.of(i - 2)) want.insert(j);
+    ASSERT_EQ(got, want) << "particle " << i;
+  }
+  EXPECT_GT(brute.pair_count(), 500u);
 }
 
 TEST(NeighbourSearch, CellSortGroupsParticlesByCellAndIsAPermutation) {
