@@ -318,27 +318,20 @@ class FluidModule final : public Module {
     // Open boundaries change the particle count: the checkpoint's count is the one to restore.
     if (auto it = state.arrays.find("mass"); it != state.arrays.end())
       fluid_.resize(it->second.size());
+    const StateReader read(state, "module '" + name_ + "'");
     for (const std::string& f : checkpointed()) {
-      auto it = state.arrays.find(f);
       auto raw = fluid_.raw(f);
-      if (it == state.arrays.end() || it->second.size() != raw.size())
-        throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
-                           std::to_string(raw.size()) + " values of '" + f + "'");
-      std::copy(it->second.begin(), it->second.end(), raw.begin());
+      const auto& saved = read.array(f, raw.size());
+      std::copy(saved.begin(), saved.end(), raw.begin());
     }
     if (walls_.moves) {
       for (const char* f : {"position", "velocity", "acceleration"}) {
-        const std::string name = std::string("wall_") + f;
-        auto it = state.arrays.find(name);
         auto raw = walls_.particles.raw(f);
-        if (it == state.arrays.end() || it->second.size() != raw.size())
-          throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
-                             std::to_string(raw.size()) + " values of '" + name + "'");
-        std::copy(it->second.begin(), it->second.end(), raw.begin());
+        const auto& saved = read.array(std::string("wall_") + f, raw.size());
+        std::copy(saved.begin(), saved.end(), raw.begin());
       }
       walls_.cells.reset();
     }
-    const StateReader read(state, "module '" + name_ + "'");
     time_ = read.scalar("time");
     steps_ = read.integer("steps");
     acoustic_steps_ = read.integer("acoustic_steps");

@@ -292,15 +292,12 @@ class SolidModule final : public StaticBodyModule<D> {
   }
 
   void load(const StateRecord& state) override {
-    for (const char* f : {"displacement", "velocity", "acceleration"}) {
-      auto it = state.arrays.find(f);
-      auto raw = particles_.raw(f);
-      if (it == state.arrays.end() || it->second.size() != raw.size())
-        throw RuntimeError("module '" + name_ + "': checkpoint does not match: expected " +
-                           std::to_string(raw.size()) + " values of '" + f + "'");
-      std::copy(it->second.begin(), it->second.end(), raw.begin());
-    }
     const StateReader read(state, "module '" + name_ + "'");
+    for (const char* f : {"displacement", "velocity", "acceleration"}) {
+      auto raw = particles_.raw(f);
+      const auto& saved = read.array(f, raw.size());
+      std::copy(saved.begin(), saved.end(), raw.begin());
+    }
     if (const auto* tension = read.optional_array("active_tension", particles_.size())) {
       if (!particles_.has("active_tension"))
         active_ = &particles_.add_scalar("active_tension", {.output = true, .checkpoint = true});

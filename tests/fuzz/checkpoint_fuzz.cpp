@@ -9,32 +9,20 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <iterator>
 #include <string>
 
 #include "checkpoint.pb.h"
-#include "core/error.hpp"
-#include "driver/simulation.hpp"
+#include "fuzz_support.hpp"
 #include "io/checkpoint_file.hpp"
-#include "module_catalogue.hpp"
-#include "scene/scene_loader.hpp"
 
 namespace {
 
 std::string scene_text() {
   std::ifstream in(COSPH_SOURCE_DIR "/tests/fuzz/checkpoint_scene.yaml");
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void require_message(const std::exception& e) {
-  if (std::string(e.what()).empty()) {
-    std::cerr << "a cosph error without a message\n";
-    std::abort();
-  }
 }
 
 }  // namespace
@@ -52,23 +40,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const std::string path = (std::filesystem::temp_directory_path() /
                                    ("cosph_checkpoint_fuzz_" + std::to_string(getpid()) + ".ckpt"))
                                       .string();
-  try {
-    cosph::write_checkpoint(path, checkpoint);
-    cosph::RunOptions options;
-    options.bench = true;
-    options.progress = false;
-    options.threads = 1;
-    options.max_steps = 2;
-    options.restart_file = path;
-    static const std::string scene = scene_text();
-    cosph::Simulation simulation(cosph::load_scene_text(scene, "checkpoint_scene.yaml"),
-                                 cosph::builtin_modules(), options);
-    simulation.initialize();
-    simulation.run();
-  } catch (const cosph::ConfigError& e) {
-    require_message(e);
-  } catch (const cosph::RuntimeError& e) {
-    require_message(e);
-  }
+  static const std::string scene = scene_text();
+  cosph::fuzz::run_two_steps(
+      [&] {
+        cosph::write_checkpoint(path, checkpoint);
+        return cosph::load_scene_text(scene, "checkpoint_scene.yaml");
+      },
+      path);
   return 0;
 }

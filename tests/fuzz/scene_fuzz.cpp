@@ -4,27 +4,11 @@
 // is a bug. Bodies are capped at 20,000 particles so that one input cannot take the machine.
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
-#include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "core/error.hpp"
-#include "driver/simulation.hpp"
-#include "module_catalogue.hpp"
-#include "scene/scene_loader.hpp"
-
-namespace {
-
-void require_message(const std::exception& e) {
-  if (std::string(e.what()).empty()) {
-    std::cerr << "a cosph error without a message\n";
-    std::abort();
-  }
-}
-
-}  // namespace
+#include "fuzz_support.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size > 1 << 16) return 0;
@@ -38,20 +22,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     text.resize(at + 1);
   }
   overrides.push_back("run.max_particles=20000");
-  try {
-    cosph::RunOptions options;
-    options.bench = true;
-    options.progress = false;
-    options.threads = 1;
-    options.max_steps = 2;
-    cosph::Simulation simulation(cosph::load_scene_text(text, "fuzz.yaml", overrides),
-                                 cosph::builtin_modules(), options);
-    simulation.initialize();
-    simulation.run();
-  } catch (const cosph::ConfigError& e) {
-    require_message(e);
-  } catch (const cosph::RuntimeError& e) {
-    require_message(e);
-  }
+  cosph::fuzz::run_two_steps([&] { return cosph::load_scene_text(text, "fuzz.yaml", overrides); });
   return 0;
 }
