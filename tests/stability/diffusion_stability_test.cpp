@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../support/reduced_run.hpp"
 #include "cli.hpp"
 #include "driver/health_monitor.hpp"
 #include "driver/simulation.hpp"
@@ -64,19 +65,22 @@ TEST(DiffusionStability, RatioHundredOnPerturbedLatticeStaysBoundedForTenThousan
   simulation.initialize();
   const double dt = simulation.module(0).max_dt();
   options.end_time = 10000.5 * dt;  // 10^4 steps (the last one partial)
-  Simulation run(load_scene_text(kHardAnisotropic, "hard.yaml"), builtin_modules(), options);
+  Simulation run(load_scene_text(kHardAnisotropic, "hard.yaml"), builtin_modules(),
+                 test::with_step_cap(options));
   run.initialize();
   const Stats before = stats(run);
   const RunSummary summary = run.run();  // the health monitor checks every 50 steps
   const Stats after = stats(run);
-  EXPECT_EQ(summary.steps, 10001u);
   EXPECT_TRUE(after.finite);
-  // Bounds stated: values within the initial range [0, 1] (discrete maximum principle), total
-  // amount conserved to 1e-12 relative, the L2 energy decreased.
+  // Bounds stated, true after any number of steps: values within the initial range [0, 1]
+  // (discrete maximum principle), total amount conserved to 1e-12 relative, the L2 energy
+  // decreased.
   EXPECT_GE(after.min, 0.0);
   EXPECT_LE(after.max, 1.0);
   EXPECT_NEAR(after.total, before.total, 1e-12 * before.total);
   EXPECT_LT(after.energy, before.energy);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
+  EXPECT_EQ(summary.steps, 10001u);
   EXPECT_LT(after.max, 0.5);  // it did diffuse
 }
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "../support/reduced_run.hpp"
 #include "../support/simulation_setup.hpp"
 
 namespace cosph {
@@ -42,15 +43,16 @@ double closest_approach(Simulation& s, double solid_spacing) {
 
 void run_to_end(const std::string& scene, const std::vector<std::string>& overrides,
                 double solid_spacing, double min_approach) {
-  auto s = test::make_simulation(example(scene), overrides);
+  auto s = test::make_simulation(example(scene), overrides, test::with_step_cap({}));
   const RunSummary summary = s->run();  // the health monitor throws on the first problem
-  EXPECT_NEAR(summary.end_time, s->scene().scene.end_time(), 1e-9);
   const double approach = s->scene().scene.dimension() == 2
                               ? closest_approach<2>(*s, solid_spacing)
                               : closest_approach<3>(*s, solid_spacing);
   std::cout << scene << ": " << summary.steps << " steps, closest fluid-solid approach " << approach
             << " solid spacings\n";
   EXPECT_GT(approach, min_approach);
+  COSPH_SKIP_CHECKS_IF_REDUCED();  // the water stays outside at every step; the end needs the run
+  EXPECT_NEAR(summary.end_time, s->scene().scene.end_time(), 1e-9);
 }
 
 // Closest approaches measured at the end (solid spacings): gate 1.98, light thin gate 2.09,

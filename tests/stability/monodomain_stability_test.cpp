@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../support/reduced_run.hpp"
 #include "driver/simulation.hpp"
 #include "module_catalogue.hpp"
 
@@ -23,7 +24,7 @@ TEST(MonodomainStability, SpiralWaveKeepsRotatingForManyTurnsAtTheLargestStableS
   Simulation simulation(
       load_scene_file(scene, {"modules[0].monodomain.body.spacing=0.025", "end_time=3000",
                               "output.interval=3000", "probes[0].interval=2"}),
-      builtin_modules(), options);
+      builtin_modules(), test::with_step_cap(options));
   simulation.initialize();
   const double dt = simulation.module(0).max_dt();
   EXPECT_GT(dt, 1.0);  // the diffusion limit at this resolution: no reaction-imposed step
@@ -41,11 +42,15 @@ TEST(MonodomainStability, SpiralWaveKeepsRotatingForManyTurnsAtTheLargestStableS
   EXPECT_LT(*vmax, 1.1);
   EXPECT_GT(*wmin, -0.2);
   EXPECT_LT(*wmax, 0.5);
+  std::cout << "V in [" << *vmin << ", " << *vmax << "], w in [" << *wmin << ", " << *wmax << "]\n";
+  COSPH_SKIP_CHECKS_IF_REDUCED();  // V and w in range at every step; the rotation needs the run
   // Still rotating: part of the tissue is excited, part is not.
   EXPECT_GT(*vmax, 0.5);
   const auto excited = std::count_if(V.begin(), V.end(), [](double v) { return v > 0.5; });
-  EXPECT_GT(excited, static_cast<long>(V.size() / 50));
-  EXPECT_LT(excited, static_cast<long>(V.size() / 2));
+  std::cout << "excited " << excited << " of " << V.size() << "\n";
+  // Measured 1682 of 10,000 (16.8%): bounded on both sides by 1.5x.
+  EXPECT_GT(excited, static_cast<long>(V.size() * 0.168 / 1.5));
+  EXPECT_LT(excited, static_cast<long>(V.size() * 0.168 * 1.5));
 
   // Rotations counted at the probe: upward crossings of V = 0.5, at a steady period.
   std::ifstream csv(options.output_directory + "/voltage.csv");
@@ -66,9 +71,10 @@ TEST(MonodomainStability, SpiralWaveKeepsRotatingForManyTurnsAtTheLargestStableS
   const double last = crossings.back() - crossings[crossings.size() - 2];
   const double before = crossings[crossings.size() - 2] - crossings[crossings.size() - 3];
   std::cout << crossings.size() << " rotations, last periods " << before << ", " << last << "\n";
-  EXPECT_NEAR(last, before, 0.05 * before);
-  EXPECT_GT(last, 150.0);
-  EXPECT_LT(last, 250.0);
+  // Measured 194.017 for both of the last two periods (15 rotations): steady, and within 3% of
+  // the measured period (a 10% change of the diffusivity moves it by more).
+  EXPECT_NEAR(last, before, 0.01 * before);
+  EXPECT_NEAR(last, 194.017, 0.03 * 194.017);
   EXPECT_GT(t_before, 2990.0);
 }
 
@@ -83,7 +89,7 @@ TEST(MonodomainStability, CoarseStepFarAboveTheReactionLimitStaysBounded) {
   options.bench = true;
   const std::string scene = std::string(COSPH_SOURCE_DIR) + "/examples/monodomain_spiral_fhn.yaml";
   Simulation simulation(load_scene_file(scene, {"modules[0].monodomain.body.spacing=0.1"}),
-                        builtin_modules(), options);
+                        builtin_modules(), test::with_step_cap(options));
   simulation.initialize();
   EXPECT_GT(simulation.module(0).max_dt(), 16.0);
   simulation.run();  // throws HealthError if V or w leave their range
@@ -94,9 +100,13 @@ TEST(MonodomainStability, CoarseStepFarAboveTheReactionLimitStaysBounded) {
   const auto [vmin, vmax] = std::minmax_element(V.begin(), V.end());
   EXPECT_GT(*vmin, -0.5);
   EXPECT_LT(*vmax, 1.1);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   const auto& activation = p.scalar("activation_time");
-  EXPECT_GE(std::count_if(activation.begin(), activation.end(), [](double t) { return t >= 0; }),
-            144);
+  const auto activated =
+      std::count_if(activation.begin(), activation.end(), [](double t) { return t >= 0; });
+  std::cout << "activated " << activated << " of " << activation.size() << "\n";
+  EXPECT_GE(activated, 144);  // measured 180: the quadrant and a ring around it, no crossing
+  EXPECT_LE(activated, 200);
 }
 
 }  // namespace

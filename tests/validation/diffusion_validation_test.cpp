@@ -7,6 +7,7 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "../support/reduced_run.hpp"
 #include "driver/simulation.hpp"
 #include "module_catalogue.hpp"
 
@@ -25,7 +26,8 @@ double relative_l2_error(const std::string& scene_file, std::vector<std::string>
   RunOptions options;
   options.bench = true;
   options.progress = false;
-  Simulation simulation(load_scene_file(scene_file, overrides), builtin_modules(), options);
+  Simulation simulation(load_scene_file(scene_file, overrides), builtin_modules(),
+                        test::with_step_cap(options));
   simulation.initialize();
   const RunSummary summary = simulation.run();
   BodyViews views;
@@ -78,6 +80,7 @@ TEST(DiffusionValidation, IsotropicGaussianErrorIsSmallAndFallsWithResolution) {
                                           isotropic_gaussian_exact);
   const double fine = relative_l2_error(scene, {iso, "modules[0].diffusion.body.spacing=0.01"},
                                         isotropic_gaussian_exact);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout << "isotropic Gaussian relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine
             << "\n";
   // Measured: 5.549e-3 and 4.515e-4 (ratio 12.3: above second order on this smooth field).
@@ -93,6 +96,7 @@ TEST(DiffusionValidation, TopHatErrorIsSmallAndFallsWithResolution) {
       relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.02"}, tophat_exact);
   const double fine =
       relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, tophat_exact);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   RecordProperty("coarse", std::to_string(coarse));
   RecordProperty("fine", std::to_string(fine));
   std::cout << "top hat relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine << "\n";
@@ -109,6 +113,7 @@ TEST(DiffusionValidation, AnisotropicGaussianErrorIsSmallAndFallsWithResolution)
       relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.02"}, anisotropic_exact);
   const double fine =
       relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout << "anisotropic Gaussian relative L2 error: dp=0.02 " << coarse << ", dp=0.01 " << fine
             << "\n";
   // Measured: 2.920e-3 and 2.755e-4 (ratio 10.6).
@@ -129,6 +134,7 @@ TEST(DiffusionValidation, KernelCorrectionIsWhatMakesAnisotropicDiffusionConverg
       relative_l2_error(scene, {off, "modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
   const double corrected =
       relative_l2_error(scene, {"modules[0].diffusion.body.spacing=0.01"}, anisotropic_exact);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout << "uncorrected: dp=0.02 " << coarse << ", dp=0.01 " << fine << "; corrected dp=0.01 "
             << corrected << "\n";
   // Measured: 4.582e-2 and 4.694e-2 uncorrected (no convergence), 2.755e-4 corrected.
@@ -144,7 +150,7 @@ TEST(DiffusionValidation, TotalAmountIsConservedToRoundOff) {
   options.progress = false;
   Simulation simulation(load_scene_file(example("diffusion_2d_anisotropic.yaml"),
                                         {"modules[0].diffusion.body.spacing=0.02"}),
-                        builtin_modules(), options);
+                        builtin_modules(), test::with_step_cap(options));
   simulation.initialize();
   auto total = [&] {
     BodyViews v;
@@ -186,7 +192,7 @@ modules:
   Simulation simulation(
       load_scene_text(text, "gaussian3d.yaml",
                       {"modules[0].diffusion.body.spacing=" + std::to_string(spacing)}),
-      builtin_modules(), options);
+      builtin_modules(), test::with_step_cap(options));
   simulation.initialize();
   const double t = simulation.run().end_time;
   BodyViews views;
@@ -209,6 +215,7 @@ modules:
 TEST(DiffusionValidation, AnisotropicGaussian3DErrorIsSmallAndFallsWithResolution) {
   std::cout.precision(6);
   const double coarse = gaussian_3d_error(0.1), fine = gaussian_3d_error(0.05);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout << "3D anisotropic Gaussian relative L2 error: dp=0.1 " << coarse << ", dp=0.05 "
             << fine << "\n";
   // Measured: 5.781e-2 and 1.397e-2 (2 particles per initial sigma; ratio 4.1, second order).

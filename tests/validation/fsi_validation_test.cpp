@@ -14,6 +14,7 @@
 #include <fstream>
 
 #include "../support/probe_csv.hpp"
+#include "../support/reduced_run.hpp"
 #include "../support/simulation_setup.hpp"
 
 namespace cosph {
@@ -44,8 +45,9 @@ GatePeaks run_gate(double fluid_spacing) {
   auto s = test::make_simulation(example("fsi_elastic_gate.yaml"),
                                  {"modules[0].fluid.body.spacing=" + std::to_string(fluid_spacing),
                                   "output.vtp=false", "checkpoint.at_end=false"},
-                                 options);
+                                 test::with_step_cap(options));
   s->run();
+  if (test::reduced_run()) return {};
   const std::string csv = options.output_directory + "/free_end.csv";
   const auto ux = test::csv_column(csv, 1), uy = test::csv_column(csv, 2);
   return {-*std::min_element(ux.begin(), ux.end()), *std::max_element(uy.begin(), uy.end())};
@@ -54,6 +56,7 @@ GatePeaks run_gate(double fluid_spacing) {
 TEST(FsiValidation, ElasticGateFreeEndConvergesTowardsThePeer) {
   const double peer_x = 0.0458, peer_y = 0.0196;  // SPHinXsys, fluid 2.5 mm, gate 1.25 mm
   const GatePeaks coarse = run_gate(0.005), fine = run_gate(0.0025);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   const double ex_coarse = coarse.horizontal / peer_x - 1, ex_fine = fine.horizontal / peer_x - 1;
   const double ey_coarse = coarse.vertical / peer_y - 1, ey_fine = fine.vertical / peer_y - 1;
   std::cout << "free end, fluid 5 mm: " << coarse.horizontal << " m, " << coarse.vertical
@@ -63,7 +66,9 @@ TEST(FsiValidation, ElasticGateFreeEndConvergesTowardsThePeer) {
   // a gate four particles thick too soft in bending).
   EXPECT_GT(ex_coarse, 0.020);
   EXPECT_LT(ex_coarse, 0.047);
-  EXPECT_LT(std::abs(ex_fine), 0.01);
+  // The horizontal error changes sign between the resolutions, so 1.5x its measured 0.015% would
+  // test where the crossing falls, not the accuracy: bounded at 0.5% instead.
+  EXPECT_LT(std::abs(ex_fine), 0.005);
   EXPECT_LT(ex_fine, ex_coarse);  // converging
   EXPECT_GT(ey_coarse, 0.064);
   EXPECT_LT(ey_coarse, 0.145);
@@ -115,11 +120,17 @@ TEST(FsiValidation, HydrostaticPlateSettlesAtTheDeflectionOfItsWaterLoad) {
   RunOptions options;
   options.output_directory = fresh_directory("cosph_hydrostatic_plate").string();
   auto coupled = test::make_simulation(example("fsi_hydrostatic_plate.yaml"),
-                                       {"output.vtp=false", "checkpoint.at_end=false"}, options);
+                                       {"output.vtp=false", "checkpoint.at_end=false"},
+                                       test::with_step_cap(options));
   coupled->run();
+  RunOptions alone_options;
+  alone_options.output_directory = fresh_directory("cosph_plate_alone").string();
+  auto alone = test::make_simulation(kPlateAlone, {}, test::with_step_cap(alone_options));
+  alone->run();
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   const std::string csv = options.output_directory + "/mid_span.csv";
   const auto t = test::csv_column(csv, 0), w = test::csv_column(csv, 1);
-  // Settled: the last tenth of the run drifts by under 1%.
+  // Settled: the last tenth of the run drifts by under 0.053% (measured 0.035%).
   double low = INFINITY, high = -INFINITY, sum = 0.0;
   int n = 0;
   for (std::size_t k = 0; k < t.size(); ++k)
@@ -130,21 +141,16 @@ TEST(FsiValidation, HydrostaticPlateSettlesAtTheDeflectionOfItsWaterLoad) {
       ++n;
     }
   const double settled = sum / n;  // the mean over the last tenth
-
-  RunOptions alone_options;
-  alone_options.output_directory = fresh_directory("cosph_plate_alone").string();
-  auto alone = test::make_simulation(kPlateAlone, {}, alone_options);
-  alone->run();
   const double loaded =
       -test::csv_column(alone_options.output_directory + "/mid_span.csv", 1).back();
   std::cout << "mid-span deflection: coupled " << settled << " m (last tenth " << low << " - "
             << high << "), plate under rho g H " << loaded << " m, continuum " << analytic
             << " m\n";
-  // Measured: the last tenth spans 0.5%; its mean is within 0.09% of the plate under the
-  // analytic load; 4 layers through the thickness with the quadratic gradient correction bend
-  // 18.7% more than the continuum (66% with the linear one).
-  EXPECT_LT((high - low) / settled, 0.01);
-  EXPECT_NEAR(settled / loaded, 1.0, 0.0015);
+  // Measured: the last tenth spans 0.035%; its mean is 0.060% below the plate under the
+  // analytic load (0.99940); 4 layers through the thickness with the quadratic gradient correction
+  // bend 18.5% more than the continuum (measured 1.18535; 66% with the linear one).
+  EXPECT_LT((high - low) / settled, 1.5 * 3.5e-4);
+  EXPECT_NEAR(settled / loaded, 1.0, 1.5 * 6.0e-4);
   EXPECT_GT(settled / analytic, 1.16);
   EXPECT_LT(settled / analytic, 1.22);
 }

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "../support/reduced_run.hpp"
 #include "driver/simulation.hpp"
 #include "module_catalogue.hpp"
 
@@ -21,7 +22,8 @@ std::map<std::string, double> final_probe(const std::string& scene,
   RunOptions options;
   options.bench = true;
   options.progress = false;
-  Simulation simulation(load_scene_file(scene, overrides), builtin_modules(), options);
+  Simulation simulation(load_scene_file(scene, overrides), builtin_modules(),
+                        test::with_step_cap(options));
   simulation.initialize();
   return simulation.run().probes.at(probe);
 }
@@ -35,6 +37,7 @@ double conduction_velocity(double spacing) {
 
 TEST(MonodomainValidation, ConductionVelocityMatchesTravellingFrontAndConverges) {
   const double coarse = conduction_velocity(0.05), fine = conduction_velocity(0.025);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout.precision(9);
   std::cout << "conduction velocity: dp 0.05 " << coarse << ", dp 0.025 " << fine
             << " (front 1.4)\n";
@@ -72,6 +75,7 @@ TEST(MonodomainValidation, AnisotropicConductionFollowsTheFibres) {
   const double along = with("[1, 0]"), across = with("[0, 1]"), diagonal = with("[1, 1]");
   const double iso4 = cv({"modules[0].monodomain.diffusivity=4"}), iso1 = cv({}),
                iso25 = cv({"modules[0].monodomain.diffusivity=2.5"});
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout.precision(9);
   std::cout << "CV along " << along << " (isotropic D = 4: " << iso4 << "), across " << across
             << " (D = 1: " << iso1 << "), 45 degrees " << diagonal << " (D = 2.5: " << iso25
@@ -90,6 +94,7 @@ TEST(MonodomainValidation, PropagationUpstrokeAtTwoResolutions) {
     return p.at("activation_time@p0");
   };
   const double coarse = upstroke(0.05), fine = upstroke(0.025);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout.precision(9);
   std::cout << "upstroke time at (0.3, 0.7): dp 0.05 " << coarse << ", dp 0.025 " << fine << "\n";
   // Against the finite-difference upstroke at (0.3, 0.7) (bench/reference/
@@ -144,12 +149,14 @@ TEST(MonodomainValidation, PlaneWaveIn3DSlabMatchesTheSame2DStrip) {
     RunOptions options;
     options.bench = true;
     options.progress = false;
-    Simulation simulation(load_scene_text(text, "slab.yaml"), builtin_modules(), options);
+    Simulation simulation(load_scene_text(text, "slab.yaml"), builtin_modules(),
+                          test::with_step_cap(options));
     simulation.initialize();
     const auto p = simulation.run().probes.at("activation");
     return 2.0 / (p.at("activation_time@p1") - p.at("activation_time@p0"));
   };
   const double two = cv(2), three = cv(3);
+  COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout.precision(9);
   std::cout << "plane wave speed, 2D strip " << two << ", 3D slab " << three << "\n";
   // Measured: 1.37318407 (2D) and 1.37317752 (3D), 4.8e-6 apart relative.
