@@ -81,7 +81,10 @@ TEST(DiffusionStability, RatioHundredOnPerturbedLatticeStaysBoundedForTenThousan
   EXPECT_LT(after.energy, before.energy);
   COSPH_SKIP_CHECKS_IF_REDUCED();
   EXPECT_EQ(summary.steps, 10001u);
-  EXPECT_LT(after.max, 0.5);  // it did diffuse
+  std::cout << "after 10^4 steps: c in [" << after.min << ", " << after.max << "]\n";
+  // It diffused, by as much as measured (peak 0.169481): bounded on both sides by 1.5x.
+  EXPECT_LT(after.max, 1.5 * 0.169481);
+  EXPECT_GT(after.max, 0.169481 / 1.5);
 }
 
 TEST(DiffusionStability, HealthMonitorStopsABlowUpNamingModuleQuantityParticleAndStep) {

@@ -106,11 +106,14 @@ void check_twisted_column(const std::vector<std::string>& overrides, const std::
         EXPECT_LE(highest, 1.0001 * initial);
         EXPECT_GT(final_ratio, final_low);
         EXPECT_LT(final_ratio, final_high);
-        // Large rotation: the top corner moved by more than half the column's width.
+        // Large rotation: the top corner moved by up to 1.439 (1.43786 with artificial
+        // viscosity), more than the column's width; bounded within 5% of it.
         const auto x = csv_column(dir + "/top.csv", 1), y = csv_column(dir + "/top.csv", 2);
         double reach = 0.0;
         for (std::size_t k = 0; k < x.size(); ++k) reach = std::max(reach, std::hypot(x[k], y[k]));
-        EXPECT_GT(reach, 0.5);
+        std::cout << tag << ": top corner moved by up to " << reach << "\n";
+        EXPECT_GT(reach, 0.95 * 1.439);
+        EXPECT_LT(reach, 1.05 * 1.439);
         const auto& J = p.scalar("J");
         for (double j : J) ASSERT_GT(j, 0.5);
       });
