@@ -80,7 +80,10 @@ class Translator {
       fail(path, "expected a mapping of keys (" + key_list(desc) + "), got " + describe(node));
     }
     for (auto it = node.begin(); it != node.end(); ++it) {
-      const std::string key = it->first.as<std::string>();
+      // A flow mapping with a missing key ("{a: 1,{b: 2}}") makes a mapping a key.
+      if (!it->first.IsScalar())
+        fail(path, "expected a key name (" + key_list(desc) + "), got " + describe(it->first));
+      const std::string key = it->first.Scalar();
       const std::string child = path.empty() ? key : path + "." + key;
       note(child, it->first);
       const gp::FieldDescriptor* field = desc->FindFieldByName(key);
@@ -451,7 +454,13 @@ LoadedScene load(const std::string& text, const std::string& name,
   std::vector<std::string> overridden;
   for (const auto& o : overrides) overridden.push_back(apply_override(root, o, loaded.source));
   for (const auto& p : overridden) loaded.source.record_override(p);
-  translator.message(root, loaded.scene, "");
+  try {
+    translator.message(root, loaded.scene, "");
+  } catch (const YAML::Exception& e) {
+    // The library's own failure, caught at our boundary; the checks above should leave none.
+    throw SceneError("", name + ":" + std::to_string(e.mark.line + 1) + ":" +
+                             std::to_string(e.mark.column + 1) + ": invalid YAML: " + e.msg);
+  }
   Validator(loaded.source, loaded.scene.dimension()).check(loaded.scene, "");
   return loaded;
 }

@@ -74,6 +74,17 @@ TEST(SceneLoader, WrongTypeIsAnError) {
                   "expected a mapping of keys");
 }
 
+// Found by scene_fuzz: a flow mapping with a missing key ("{name: c,{box: ...}}") makes a mapping
+// a key; yaml-cpp's conversion of it to a name threw TypedBadConversion out of the loader.
+TEST(SceneLoader, MappingAsAKeyIsAnError) {
+  const std::string msg = error_of(replace(kValid, "{at: [[0.5, 0.5]], fields: [concentration]}",
+                                           "{at: [[0.5, 0.5]],{fields: [concentration]}}"));
+  EXPECT_CONTAINS(msg, "scene.yaml:14:");
+  EXPECT_CONTAINS(msg, "probes[0].points");
+  EXPECT_CONTAINS(msg, "expected a key name");
+  EXPECT_CONTAINS(msg, "got a mapping");
+}
+
 TEST(SceneLoader, MissingRequiredValueIsAnError) {
   const std::string msg = error_of(replace(kValid, "end_time: 1.0\n", ""));
   EXPECT_CONTAINS(msg, "end_time");
