@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.hpp"
 #include "core/parallel.hpp"
 
 namespace cosph {
@@ -40,9 +41,13 @@ CellLinkedList<D>::CellLinkedList(const std::vector<Vec<D>>& positions, double c
       origin_[a] = domain.lower[a];
       const double L = domain.length(a);
       if (std::floor(L / cutoff) < 3)
-        throw std::invalid_argument(
-            "periodic axis " + std::to_string(a) + " is " + std::to_string(L) +
-            " long, shorter than three cut-off radii (" + std::to_string(3 * cutoff) + ")");
+        // A scene's input (its domain against its spacing): a ConfigError, which every caller
+        // reports with its key path (found by scene_fuzz: std::invalid_argument escaped the run).
+        throw ConfigError("domain.periodic", "periodic axis " + std::to_string(a) + " is " +
+                                                 std::to_string(L) +
+                                                 " long, shorter than three cut-off radii (" +
+                                                 std::to_string(3 * cutoff) +
+                                                 "): make the spacing finer or the period longer");
       // On a periodic axis the cells must tile the period exactly; they stay at least
       // cell_size_ wide, and there are at least 2 reach + 1 of them so that a stencil never
       // meets the same cell twice (then L / (2 reach + 1) times reach still covers the cut-off,
