@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
+#include "driver/health_monitor.hpp"
 #include "driver/scene_geometry.hpp"
 #include "driver/state_reader.hpp"
 #include "expression/expression.hpp"
@@ -40,13 +41,8 @@ class FluidModule final : public Module {
         fluid_(spec_.body().name().empty() ? spec.name() : spec_.body().name()),
         walls_(name_ + "_walls"),
         contact_(name_ + "_contact"),
-        open_(spec_, kernel_.support_radius(), key_) {
-    if (spec_.has_sound_speed())
-      sound_speed_ = spec_.sound_speed();
-    else if (spec_.has_max_velocity())
-      sound_speed_ = 10.0 * spec_.max_velocity();
-    else
-      throw ConfigError(key_, "give max_velocity (the sound speed is 10 U_max) or sound_speed");
+        open_(spec_, kernel_.support_radius(), sound_speed_of(spec_, key_), key_) {
+    sound_speed_ = sound_speed_of(spec_, key_);
     if (spec_.gravity_size() > 0) gravity_ = to_vec<D>(spec_.gravity());
     for (int a = 0; a < spec_.initial_velocity_size(); ++a)
       initial_velocity_.push_back(
@@ -167,7 +163,9 @@ class FluidModule final : public Module {
   double max_substep() const override {
     if (step_done_ >= step_size_ * (1.0 - 1e-12)) return 0.0;
     const double h = kernel_.smoothing_length();
-    double dt = spec_.acoustic_cfl() * h / (sound_speed_ + max_speed());
+    const double speed = max_speed();
+    if (!(speed <= sound_speed_)) throw_supersonic(time_ + step_done_);
+    double dt = spec_.acoustic_cfl() * h / (sound_speed_ + speed);
     if (viscous_substeps()) dt = std::min(dt, viscous_dt());
     return std::min(dt, step_size_ - step_done_);
   }
@@ -367,6 +365,12 @@ class FluidModule final : public Module {
  private:
   static constexpr long long kSortInterval = 100;
 
+  static double sound_speed_of(const proto::FluidSpec& spec, const std::string& key) {
+    if (spec.has_sound_speed()) return spec.sound_speed();
+    if (spec.has_max_velocity()) return 10.0 * spec.max_velocity();
+    throw ConfigError(key, "give max_velocity (the sound speed is 10 U_max) or sound_speed");
+  }
+
   static Expression parse(const std::string& text, const std::string& key) {
     try {
       return Expression::parse(text, {"x", "y", "z"});
@@ -400,6 +404,25 @@ class FluidModule final : public Module {
     double s = 0.0;
     for (const auto& u : v) s = std::max(s, u.squaredNorm());
     return std::sqrt(s);
+  }
+
+  // A particle at or past the sound speed (or not finite): the weakly compressible scheme no
+  // longer holds, and the acoustic step, 0.6 h / (c + |v|), would shrink without bound inside
+  // one advection step. Checked at every sub-step (the health monitor runs every few steps),
+  // from the maximum the step size needs anyway.
+  [[noreturn]] void throw_supersonic(double t) const {
+    const auto& v = fluid_.vector("velocity");
+    const auto& x = fluid_.vector("position");
+    std::size_t worst = 0;
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (!(v[i].norm() <= v[worst].norm())) worst = i;
+    std::ostringstream m;
+    m << "health check failed at t = " << t << ": module '" << name_ << "', body '" << fluid_.name()
+      << "': speed = " << v[worst].norm() << " at particle " << worst << ", position ("
+      << x[worst].transpose() << "); expected below the sound speed " << sound_speed_
+      << " (past it the weakly compressible scheme does not hold: if the flow is "
+      << "meant to be this fast, raise max_velocity or sound_speed)";
+    throw HealthError(m.str());
   }
 
   RiemannSolver riemann() const {

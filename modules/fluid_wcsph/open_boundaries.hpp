@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,12 +21,14 @@ namespace cosph {
 template <int D>
 class OpenBoundaries {
  public:
-  // Validates the scene's open boundaries (key: the fluid's key path).
-  OpenBoundaries(const proto::FluidSpec& spec, double support, const std::string& key)
-      : support_(support) {
+  // Validates the scene's open boundaries (key: the fluid's key path; sound_speed: the fluid's,
+  // which a prescribed inflow speed must stay below).
+  OpenBoundaries(const proto::FluidSpec& spec, double support, double sound_speed,
+                 const std::string& key)
+      : support_(support), sound_speed_(sound_speed) {
     if (spec.has_inflow()) {
       const auto& in = spec.inflow();
-      const std::string path = key + ".inflow";
+      const std::string& path = path_ = key + ".inflow";
       if (in.axis() >= D) throw ConfigError(path + ".axis", "axis must be below the dimension");
       inflow_ = true;
       inflow_axis_ = in.axis();
@@ -99,7 +102,9 @@ class OpenBoundaries {
     return t;
   }
 
-  // The buffer particles take the prescribed velocity at time t.
+  // The buffer particles take the prescribed velocity at time t. A prescribed speed at or past
+  // the sound speed (or not finite) is refused with the key that prescribes it: the scheme could
+  // not follow it (the acoustic step would shrink without bound).
   void impose(ParticleSet<D>& fluid, double t) const {
     if (!inflow_) return;
     const auto& x = fluid.vector("position");
@@ -110,6 +115,7 @@ class OpenBoundaries {
       std::array<double, 4> p{0.0, 0.0, 0.0, t};
       for (int a = 0; a < D; ++a) p[a] = x[i][a];
       for (int a = 0; a < D; ++a) v[i][a] = velocity_[a].evaluate(p);
+      if (!(v[i].norm() <= sound_speed_)) throw_supersonic(v[i].norm(), p);
     }
   }
 
@@ -148,13 +154,23 @@ class OpenBoundaries {
 
  private:
   double length() const { return upper_[inflow_axis_] - lower_[inflow_axis_]; }
+
+  [[noreturn]] void throw_supersonic(double speed, const std::array<double, 4>& p) const {
+    std::ostringstream m;
+    m << "the prescribed speed is " << speed << " at t = " << p[3] << ", position (" << p[0];
+    for (int a = 1; a < D; ++a) m << ", " << p[a];
+    m << "): it must stay below the sound speed " << sound_speed_
+      << " (raise max_velocity or sound_speed if the flow is meant to be this fast)";
+    throw ConfigError(path_ + ".velocity", m.str());
+  }
   bool inside_buffer(const Vec<D>& x) const {
     for (int a = 0; a < D; ++a)
       if (x[a] < lower_[a] || x[a] > upper_[a]) return false;
     return true;
   }
 
-  double support_;
+  double support_, sound_speed_;
+  std::string path_;  // the inflow's key path, for errors while running
   bool inflow_ = false, outflow_ = false;
   int inflow_axis_ = 0, outflow_axis_ = 0;
   double outflow_position_ = 0.0;

@@ -186,5 +186,30 @@ TEST(FluidOpenBoundary, BadInputNamesTheKey) {
             std::string::npos);
 }
 
+// An inflow that accelerates past the sound speed (c = 10 max_velocity = 10 here) within an
+// advection step used to shrink the acoustic step without bound, 0.6 h / (c + |v|): a fuzzed
+// cylinder scene with a factor -9.2e18 in its inflow ran for hours inside its second step. Now
+// the run stops at the first sub-step past c, naming the key, the speed, the time and the place.
+TEST(FluidOpenBoundary, InflowPastTheSoundSpeedIsRefusedWithItsKey) {
+  std::string key, message;
+  try {
+    make_simulation(kChannel, {"modules[0].fluid.inflow.velocity[0]=1e6 * t^2"})->run();
+  } catch (const ConfigError& e) {
+    key = e.key_path();
+    message = e.what();
+  }
+  std::cout << key << ": " << message << "\n";
+  EXPECT_EQ(key, "modules[0].fluid.inflow.velocity");
+  for (const char* part :
+       {"the prescribed speed is ", "must stay below the sound speed 10", "raise max_velocity"})
+    EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+  // Past c at t = sqrt(1e-5) = 3.16e-3 s, within the first advection steps.
+  const auto at = message.find(" at t = ");
+  ASSERT_NE(at, std::string::npos) << message;
+  const double t = std::stod(message.substr(at + 8));
+  EXPECT_GT(t, std::sqrt(1e-5));
+  EXPECT_LT(t, std::sqrt(1e-5) + 2e-3);
+}
+
 }  // namespace
 }  // namespace cosph

@@ -106,5 +106,17 @@ TEST(HealthChecks, ParticleLeavingTheDomain) {
   EXPECT_LT(t, 0.130) << message;
 }
 
+// A particle past the sound speed stops the run at the sub-step that sees it, not on the
+// monitor's schedule (every 1000 steps here): past c the acoustic step 0.6 h / (c + |v|) would
+// shrink without bound inside one advection step. u = 40 x is 19 m/s at the right-most column
+// (x = 0.475), against c = 10 m/s.
+TEST(HealthChecks, FluidParticlePastTheSoundSpeed) {
+  const std::string message = health_error(
+      kWater,
+      {"run.health_interval=1000", "modules[0].fluid.initial_velocity=[\"40 * x\", \"0\"]"});
+  expect_contains(message, {"health check failed at t = 0:", "module 'water'", "speed = 19 ",
+                            "expected below the sound speed 10", "raise max_velocity"});
+}
+
 }  // namespace
 }  // namespace cosph
