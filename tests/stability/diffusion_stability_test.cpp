@@ -82,9 +82,11 @@ TEST(DiffusionStability, RatioHundredOnPerturbedLatticeStaysBoundedForTenThousan
   COSPH_SKIP_CHECKS_IF_REDUCED();
   EXPECT_EQ(summary.steps, 10001u);
   std::cout << "after 10^4 steps: c in [" << after.min << ", " << after.max << "]\n";
-  // It diffused, by as much as measured (peak 0.169481): bounded on both sides by 1.5x.
-  EXPECT_LT(after.max, 1.5 * 0.169481);
-  EXPECT_GT(after.max, 0.169481 / 1.5);
+  // It diffused, by as much as measured (peak 0.169481), bounded 2% either side: a diffusion
+  // operator 10% too strong lowers the peak of a spreading blob by 5% (quasi-1D, peak ~
+  // 1/sqrt(D t)) to 9% (2D, peak ~ 1/(D t)).
+  EXPECT_LT(after.max, 1.02 * 0.169481);
+  EXPECT_GT(after.max, 0.98 * 0.169481);
 }
 
 TEST(DiffusionStability, HealthMonitorStopsABlowUpNamingModuleQuantityParticleAndStep) {

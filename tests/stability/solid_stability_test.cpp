@@ -5,6 +5,7 @@
 // monitor (finite fields, J > 0) runs every 100 steps; a violation throws.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -42,8 +43,8 @@ void run(const std::string& scene, const std::vector<std::string>& overrides,
 
 // Measured at the example's 1 mm (3,196 particles): J in [0.948561, 1.06544] (the extremes sit
 // at the clamped base's rim), the wall's deformed volume sum J V0 / sum V0 = 0.999519, final
-// kinetic energy 2.5e-29 of its peak 1.6e-5 J, the endocardial apex at z = -24.0746 mm (issue 13
-// studies how it converges; here it guards the value).
+// kinetic energy 2.54e-29 J, 1.54e-24 of its peak 1.648e-5 J, the endocardial apex at z = -24.0746
+// mm (issue 13 studies how it converges; here it guards the value).
 TEST(SolidStability, NearlyIncompressibleVentricleComesToRest) {
   run(example("solid_land_ventricle.yaml"), {"output.interval=0.25"}, "ventricle",
       [](const ParticleSet<3>& p, const std::string& dir) {
@@ -63,8 +64,12 @@ TEST(SolidStability, NearlyIncompressibleVentricleComesToRest) {
         EXPECT_NEAR(deformed / reference, 1.0, 1.5 * 4.81e-4);  // measured 1 - 4.81e-4
         const auto kinetic = csv_column(dir + "/kinetic_energy.csv", 1);
         const double peak = *std::max_element(kinetic.begin(), kinetic.end());
-        std::cout << "kinetic energy: peak " << peak << ", final " << kinetic.back() << "\n";
-        EXPECT_LT(kinetic.back(), 1e-6 * peak);  // at rest: no ringing left
+        std::cout << "kinetic energy: peak " << peak << ", final " << kinetic.back() << " ("
+                  << kinetic.back() / peak << " of the peak)\n";
+        // At rest: no ringing left. The damped decay is exponential (24 decades over the run), so
+        // the bound is on its order of magnitude: 1e-22 of the peak against the measured 1.54e-24
+        // (10% less damping leaves about 150 times more).
+        EXPECT_LT(kinetic.back(), 1e-22 * peak);
         const double apex = csv_column(dir + "/apex.csv", 1).back();
         std::cout << "endocardial apex z " << apex * 1e3 << " mm\n";
         // Both sides, 8% of the apex's 4.07 mm travel from -20 mm.
@@ -103,7 +108,9 @@ void check_twisted_column(const std::vector<std::string>& overrides, const std::
                   << " extreme twists, energy max/initial " << highest / initial
                   << ", final/initial " << final_ratio << "\n";
         EXPECT_GE(turns, 10);  // several torsional half periods (measured 11)
-        EXPECT_LE(highest, 1.0001 * initial);
+        std::cout << tag << ": highest energy - initial " << (highest - initial) / initial
+                  << " of the initial\n";
+        EXPECT_LE(highest, initial);  // measured: no sample above the initial energy (excess 0)
         EXPECT_GT(final_ratio, final_low);
         EXPECT_LT(final_ratio, final_high);
         // Large rotation: the top corner moved by up to 1.439 (1.43786 with artificial
@@ -115,7 +122,14 @@ void check_twisted_column(const std::vector<std::string>& overrides, const std::
         EXPECT_GT(reach, 0.95 * 1.439);
         EXPECT_LT(reach, 1.05 * 1.439);
         const auto& J = p.scalar("J");
-        for (double j : J) ASSERT_GT(j, 0.5);
+        std::cout << tag << ": J in [" << *std::min_element(J.begin(), J.end()) << ", "
+                  << *std::max_element(J.begin(), J.end()) << "]\n";
+        // Measured J in [0.960444, 1.02734] (with artificial viscosity [0.957103, 1.02479]):
+        // bounded at 1.5x the larger excursions from 1.
+        for (double j : J) {
+          ASSERT_GT(j, 1.0 - 1.5 * (1.0 - 0.957103));
+          ASSERT_LT(j, 1.0 + 1.5 * (1.02734 - 1.0));
+        }
       });
 }
 

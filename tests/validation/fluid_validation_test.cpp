@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "../support/probe_csv.hpp"
@@ -91,7 +92,10 @@ TEST(FluidValidation, DamBreakImpactAndPlateauAtSensorsOneAndThreeMatchTheExperi
   // The water level at gauge H1 (x = H), every time unit until the reflected wave returns.
   const Series gauge = read_probe(options.output_directory + "/gauge_H1.csv", 1);
   const Series level = read_experiment("lobovsky2014_gauge_H1.csv");
-  for (double t : {1.0, 2.0, 3.0, 4.0}) {
+  // Measured -0.0119, +0.0007, +0.0108, +0.0127 H at t = 1, 2, 3, 4; each bounded at 1.5x, except
+  // at t = 2, where the two curves happen to cross: there 0.004 H (a sixth of the H/40 spacing).
+  const std::map<double, double> bound = {{1.0, 0.018}, {2.0, 0.004}, {3.0, 0.016}, {4.0, 0.019}};
+  for (const auto& [t, allowed] : bound) {
     auto at = [t](const Series& s) {
       std::size_t k = 0;
       while (k + 1 < s.t.size() && s.t[k + 1] <= t) ++k;
@@ -99,8 +103,7 @@ TEST(FluidValidation, DamBreakImpactAndPlateauAtSensorsOneAndThreeMatchTheExperi
     };
     std::cout << "gauge H1 at t = " << t << ": " << at(gauge) << " (experiment " << at(level)
               << ")\n";
-    // Measured -0.0119, +0.0007, +0.0108, +0.0127 H at t = 1, 2, 3, 4.
-    EXPECT_NEAR(at(gauge), at(level), 0.019);
+    EXPECT_NEAR(at(gauge), at(level), allowed) << "gauge H1 at t = " << t;
   }
 }
 
@@ -188,8 +191,8 @@ TEST(FluidValidation, TaylorGreenVortexDecaysAtTheAnalyticRate) {
   COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout << "Taylor-Green, 8 sweeps: kinetic energy relative L2 " << run.l2_error
             << ", final / analytic " << run.final_ratio << "\n";
-  EXPECT_LT(run.l2_error, 0.08);            // measured 0.051
-  EXPECT_NEAR(run.final_ratio, 1.0, 0.12);  // measured 0.93
+  EXPECT_LT(run.l2_error, 1.5 * 0.0504392);           // measured 0.0504392
+  EXPECT_NEAR(run.final_ratio, 1.0, 1.5 * 0.069943);  // measured 0.930057
 }
 
 // Without the shift the lattice holds until the stagnation-point strain buckles it (t ~ 0.15):
@@ -230,7 +233,8 @@ TEST(FluidValidation, CylinderSheddingAtRe100MatchesTheBenchmark) {
       drag.push_back(20.0 * fx[k]);  // C = 2 F / (rho U^2 D), U = 1, D = 0.1
       lift.push_back(20.0 * fy[k]);
     }
-  ASSERT_GT(time.size(), 300u);
+  std::cout << time.size() << " force samples over t = 4-6\n";
+  ASSERT_EQ(time.size(), 401u);  // every 0.005 over [4, 6]: a structural check
   double mean_drag = 0.0, mean_lift = 0.0;
   for (std::size_t k = 0; k < time.size(); ++k) {
     mean_drag += drag[k] / time.size();

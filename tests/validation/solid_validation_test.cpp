@@ -49,6 +49,8 @@ TEST(SolidValidation, OscillatingPlatePeriodApproachesLinearTheoryAndKeepsItsEne
   COSPH_SKIP_CHECKS_IF_REDUCED();
   const auto t = csv_column(dir + "/tip.csv", 0), y = csv_column(dir + "/tip.csv", 1);
   const auto crossings = downward_crossings(t, y);
+  // A precondition, not a bound: enough swings to average a period over (fewer means the plate
+  // stopped swinging).
   ASSERT_GE(crossings.size(), 4u);
   const double period = (crossings.back() - crossings.front()) / (crossings.size() - 1);
   const double theory = 0.2541;  // omega^2 = E H^2 k^4 / (12 rho (1 - nu^2)), kL = 1.875
@@ -110,6 +112,7 @@ TEST(SolidValidation, BendingCantileverSwingsWithTheFirstModePeriod) {
   std::vector<double> lateral(x.size());  // along the initial velocity (sqrt 3, 1, 0) / 2
   for (std::size_t k = 0; k < x.size(); ++k) lateral[k] = 0.5 * std::sqrt(3.0) * x[k] + 0.5 * y[k];
   const auto crossings = downward_crossings(t, lateral);
+  // A precondition, not a bound: one full swing to measure (the run covers a little more).
   ASSERT_GE(crossings.size(), 2u);
   const double period = crossings[1] - crossings[0];
   std::cout << "cantilever period " << period << " s (Euler-Bernoulli 1.79 s)\n";
