@@ -6,9 +6,12 @@
 // with clang) explores much further; this keeps the targets exercised in every CI run under
 // AddressSanitizer and UndefinedBehaviorSanitizer.
 //
-// usage: TARGET SECONDS SEED_FILE_OR_DIRECTORY...   (exit 0; a bug aborts the process)
+// usage: TARGET SECONDS SEED_FILE_OR_DIRECTORY...   (exit 0; a bug or a hang aborts the process)
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -131,12 +134,29 @@ std::string mutate(const std::vector<std::string>& seeds, std::mt19937_64& rng) 
   return s;
 }
 
+// An input that runs longer than this is a hang (libFuzzer's -timeout): the process aborts, so a
+// hang fails the run instead of stalling it past its time (COSPH_FUZZ_TIMEOUT=SECONDS changes it).
+unsigned input_timeout() {
+  const char* value = std::getenv("COSPH_FUZZ_TIMEOUT");
+  const int seconds = value ? std::atoi(value) : 60;
+  return seconds > 0 ? static_cast<unsigned>(seconds) : 60u;
+}
+
+extern "C" void on_timeout(int) {
+  const char message[] = "fuzz driver: one input ran past the per-input timeout (a hang)\n";
+  [[maybe_unused]] const auto written = write(STDERR_FILENO, message, sizeof message - 1);
+  std::abort();
+}
+
 // With COSPH_FUZZ_LAST=FILE each input is written there before it runs: after a crash or a hang
 // the file holds the input that caused it (run the target with it as its only seed, 0 seconds).
 void run_one(const std::string& input) {
+  static const unsigned timeout = input_timeout();
   if (const char* last = std::getenv("COSPH_FUZZ_LAST"))
     std::ofstream(last, std::ios::binary | std::ios::trunc) << input;
+  alarm(timeout);
   LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(input.data()), input.size());
+  alarm(0);
 }
 
 }  // namespace
@@ -152,6 +172,7 @@ int main(int argc, char** argv) {
     std::cerr << argv[0] << ": no seed inputs\n";
     return 2;
   }
+  std::signal(SIGALRM, on_timeout);
   for (const auto& s : seeds) run_one(s);
   std::mt19937_64 rng(20261202);
   const auto start = std::chrono::steady_clock::now();
