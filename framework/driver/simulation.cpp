@@ -5,6 +5,7 @@
 #include <tbb/info.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -159,6 +160,31 @@ struct Simulation::Impl {
   double output_seconds = 0.0;
 };
 
+namespace {
+
+// Event times are compared with a tolerance of 1e-12 of the run (at least 1e-12), so an interval
+// must be well above it: one below 1e-9 of max(1, end_time) is refused before anything is built
+// (a fuzzed output interval of 5e-322 spun the event loop through 1e309 grid points at t = 0).
+// It is also a billion files: no scene means it.
+void check_event_intervals(const proto::Scene& s, double end) {
+  const double shortest = 1e-9 * std::max(1.0, end);
+  auto check = [&](bool set, double interval, const std::string& key) {
+    if (!set || interval >= shortest) return;
+    std::ostringstream m;
+    m << "interval " << interval << " is shorter than " << shortest
+      << ", 1e-9 of the run (end time " << end
+      << ", at least 1): the event grid cannot be resolved";
+    throw ConfigError(key, m.str());
+  };
+  check(s.output().has_interval(), s.output().interval(), "output.interval");
+  check(s.checkpoint().has_interval(), s.checkpoint().interval(), "checkpoint.interval");
+  for (int k = 0; k < s.probes_size(); ++k)
+    check(s.probes(k).has_interval(), s.probes(k).interval(),
+          "probes[" + std::to_string(k) + "].interval");
+}
+
+}  // namespace
+
 Simulation::Simulation(LoadedScene scene, const ModuleRegistry& registry, RunOptions options)
     : scene_(std::move(scene)),
       registry_(registry),
@@ -176,6 +202,7 @@ void Simulation::initialize() {
       std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
 
   try {
+    check_event_intervals(s, options_.end_time >= 0.0 ? options_.end_time : s.end_time());
     if (s.modules_size() > 1) {
       std::set<std::string> names;
       for (int k = 0; k < s.modules_size(); ++k)

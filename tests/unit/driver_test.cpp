@@ -306,5 +306,32 @@ TEST(CommandLine, ExitCodesAndMessages) {
   EXPECT_LT(summary.end_time, 0.5);
 }
 
+// An event interval below 1e-9 of the run is refused before anything is built, with its key: a
+// fuzzed output interval of 5e-322 spun the event loop at t = 0 (found by scene_fuzz, a hang).
+TEST(Driver, EventIntervalTooShortToResolveIsRefusedWithItsKey) {
+  for (const std::string key : {"output.interval", "checkpoint.interval", "probes[1].interval"}) {
+    RunOptions options;
+    options.bench = true;
+    options.progress = false;
+    Simulation simulation(load_scene_text(kScene, "scene.yaml", {key + "=5e-322"}),
+                          builtin_modules(), options);
+    try {
+      simulation.initialize();
+      ADD_FAILURE() << key << " = 5e-322 was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key_path(), key);
+      const std::string message = e.what();
+      EXPECT_NE(message.find("shorter than 2e-09, 1e-9 of the run (end time 2"), std::string::npos)
+          << message;
+    }
+  }
+  // 2e-9 itself is accepted (the run is not started here: it would take 1e9 steps).
+  RunOptions bench;
+  bench.bench = true;
+  Simulation fine(load_scene_text(kScene, "scene.yaml", {"output.interval=2e-9"}),
+                  builtin_modules(), bench);
+  EXPECT_NO_THROW(fine.initialize());
+}
+
 }  // namespace
 }  // namespace cosph
