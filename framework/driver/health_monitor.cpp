@@ -7,9 +7,10 @@ namespace cosph {
 
 namespace {
 
-std::string where(unsigned long long step, double time) {
+template <class V>
+std::string text_of(const V& x) {
   std::ostringstream s;
-  s << "health check failed at step " << step << " (t = " << time << "): ";
+  s << x.transpose();
   return s.str();
 }
 
@@ -19,12 +20,10 @@ void check_body(const BodyView<D>& view, bool check_domain, unsigned long long s
   const auto* x = p.has("position") ? &p.vector("position") : nullptr;
   auto fail = [&](const std::string& quantity, std::size_t i, double value,
                   const std::string& expected) {
-    std::ostringstream msg;
-    msg << where(step, time) << "module '" << view.module << "', body '" << p.name()
-        << "': " << quantity << " = " << value << " at particle " << i;
-    if (x && i < x->size()) msg << ", position (" << (*x)[i].transpose() << ")";
-    msg << "; expected " << expected;
-    throw HealthError(msg.str());
+    const std::string position = x && i < x->size() ? text_of((*x)[i]) : std::string();
+    throw HealthError(
+        health_failure_message({step, time, view.module, p.name(), position},
+                               {quantity, static_cast<long long>(i), value, expected}));
   };
   for (std::size_t k = 0; k < p.field_count(); ++k) {
     const FieldInfo& info = p.info(k);
@@ -44,6 +43,22 @@ void check_body(const BodyView<D>& view, bool check_domain, unsigned long long s
 
 }  // namespace
 
+std::string health_failure_message(const HealthContext& where, const HealthProblem& problem) {
+  std::ostringstream msg;
+  msg << "health check failed at ";
+  if (where.step)
+    msg << "step " << *where.step << " (t = " << where.time << ")";
+  else
+    msg << "t = " << where.time;
+  msg << ": module '" << where.module << "'";
+  if (!where.body.empty()) msg << ", body '" << where.body << "'";
+  msg << ": " << problem.quantity << " = " << problem.value;
+  if (problem.particle >= 0) msg << " at particle " << problem.particle;
+  if (!where.position.empty()) msg << ", position (" << where.position << ")";
+  msg << "; expected " << problem.expected;
+  return msg.str();
+}
+
 void HealthMonitor::check(const std::vector<const Module*>& modules, unsigned long long step,
                           double time) const {
   for (const Module* m : modules) {
@@ -52,27 +67,21 @@ void HealthMonitor::check(const std::vector<const Module*>& modules, unsigned lo
     for (const auto& b : views.bodies2) check_body<2>(b, check_domain_, step, time);
     for (const auto& b : views.bodies3) check_body<3>(b, check_domain_, step, time);
     if (auto problem = m->check_health()) {
-      std::ostringstream msg;
-      msg << where(step, time) << "module '" << m->info().name << "': " << problem->quantity
-          << " = " << problem->value;
+      std::string position;
       if (problem->particle >= 0) {
-        msg << " at particle " << problem->particle;
-        BodyViews v;
-        m->bodies(v);
-        const auto position = [&](const auto& list) {
+        const auto find = [&](const auto& list) {
           for (const auto& b : list)
             if (b.particles->has("position") &&
                 static_cast<std::size_t>(problem->particle) < b.particles->size()) {
-              msg << ", position ("
-                  << b.particles->vector("position")[problem->particle].transpose() << ")";
+              position = text_of(b.particles->vector("position")[problem->particle]);
               return true;
             }
           return false;
         };
-        if (!position(v.bodies2)) position(v.bodies3);
+        if (!find(views.bodies2)) find(views.bodies3);
       }
-      msg << "; expected " << problem->expected;
-      throw HealthError(msg.str());
+      throw HealthError(
+          health_failure_message({step, time, m->info().name, "", position}, *problem));
     }
   }
 }

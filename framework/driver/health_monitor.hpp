@@ -5,6 +5,8 @@
 #pragma once
 
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "core/error.hpp"
@@ -16,6 +18,18 @@ class HealthError : public RuntimeError {
  public:
   using RuntimeError::RuntimeError;
 };
+
+// The one wording of a health failure, for the monitor and for a module that checks a bound
+// between the monitor's checks (the fluid's sound speed, at every acoustic sub-step): "health
+// check failed at step S (t = T): module 'M', body 'B': quantity = value at particle i, position
+// (x); expected ...". The step is the driver's; a module that does not know it passes nullopt.
+struct HealthContext {
+  std::optional<unsigned long long> step;
+  double time = 0.0;
+  std::string module, body;  // body empty: the module's own quantity
+  std::string position;      // "x y z" of the particle, or empty
+};
+std::string health_failure_message(const HealthContext& where, const HealthProblem& problem);
 
 class HealthMonitor {
  public:

@@ -39,10 +39,10 @@ class FluidModule final : public Module {
         kernel_(build_kernel(spec_.body(), D)),
         domain_(build_domain<D>(*context.scene)),
         fluid_(spec_.body().name().empty() ? spec.name() : spec_.body().name()),
+        sound_speed_(sound_speed_of(spec_, key_)),
         walls_(name_ + "_walls"),
         contact_(name_ + "_contact"),
-        open_(spec_, kernel_.support_radius(), sound_speed_of(spec_, key_), key_) {
-    sound_speed_ = sound_speed_of(spec_, key_);
+        open_(spec_, kernel_.support_radius(), sound_speed_, key_) {
     if (spec_.gravity_size() > 0) gravity_ = to_vec<D>(spec_.gravity());
     for (int a = 0; a < spec_.initial_velocity_size(); ++a)
       initial_velocity_.push_back(
@@ -416,13 +416,15 @@ class FluidModule final : public Module {
     std::size_t worst = 0;
     for (std::size_t i = 0; i < v.size(); ++i)
       if (!(v[i].norm() <= v[worst].norm())) worst = i;
-    std::ostringstream m;
-    m << "health check failed at t = " << t << ": module '" << name_ << "', body '" << fluid_.name()
-      << "': speed = " << v[worst].norm() << " at particle " << worst << ", position ("
-      << x[worst].transpose() << "); expected below the sound speed " << sound_speed_
-      << " (past it the weakly compressible scheme does not hold: if the flow is "
-      << "meant to be this fast, raise max_velocity or sound_speed)";
-    throw HealthError(m.str());
+    std::ostringstream position;
+    position << x[worst].transpose();
+    std::ostringstream expected;
+    expected << "below the sound speed " << sound_speed_
+             << " (past it the weakly compressible scheme does not hold: if the flow is meant to "
+                "be this fast, raise max_velocity or sound_speed)";
+    throw HealthError(health_failure_message(
+        {std::nullopt, t, name_, fluid_.name(), position.str()},
+        {"speed", static_cast<long long>(worst), v[worst].norm(), expected.str()}));
   }
 
   RiemannSolver riemann() const {
@@ -861,6 +863,7 @@ class FluidModule final : public Module {
   Kernel kernel_;
   Domain<D> domain_;
   ParticleSet<D> fluid_;
+  double sound_speed_;  // before open_, which takes it
   BoundarySet<D> walls_, contact_;
   OpenBoundaries<D> open_;
   std::vector<int> wall_owner_;
@@ -868,7 +871,7 @@ class FluidModule final : public Module {
   std::vector<Expression> initial_velocity_;
   Expression initial_pressure_;
   Vec<D> gravity_ = Vec<D>::Zero();
-  double sound_speed_ = 0.0, reference_number_density_ = 1.0;
+  double reference_number_density_ = 1.0;
   NeighbourList inner_;
   PairGeometry<D> inner_geometry_;
   std::vector<Vec<D>> dv_, shift_;
