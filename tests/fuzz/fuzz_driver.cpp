@@ -31,6 +31,10 @@ std::vector<std::string> read_seeds(int argc, char** argv) {
   std::vector<std::string> seeds;
   auto add = [&](const std::filesystem::path& file) {
     std::ifstream in(file, std::ios::binary);
+    if (!in) {  // a mistyped seed would fuzz an empty input and look like a clean run
+      std::cerr << argv[0] << ": cannot read seed " << file << "\n";
+      std::exit(2);
+    }
     seeds.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   };
   for (int k = 2; k < argc; ++k) {
