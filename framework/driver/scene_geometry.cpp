@@ -97,7 +97,9 @@ ParticleCloud<D> build_body(const proto::BodySpec& spec, const std::string& key_
   auto shape = build_shape<D>(spec.shape(), key_path + ".shape");
   ParticleCloud<D> cloud;
   try {
-    cloud = lattice_fill<D>(*shape, spec.spacing(), to_vec<D>(spec.lattice_anchor()));
+    const auto placement =
+        spec.placement() == "vertex" ? LatticePlacement::vertex : LatticePlacement::cell;
+    cloud = lattice_fill<D>(*shape, spec.spacing(), to_vec<D>(spec.lattice_anchor()), placement);
   } catch (const std::invalid_argument& e) {
     throw ConfigError(key_path, e.what());
   }

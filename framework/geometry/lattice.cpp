@@ -12,21 +12,66 @@
 
 namespace cosph {
 
+namespace {
+
+// Calls f(offset) for the 2^D corners of the cube [-r, r]^D.
+template <int D, typename F>
+bool any_corner(double r, const F& f) {
+  for (int c = 0; c < (1 << D); ++c) {
+    Vec<D> offset;
+    for (int a = 0; a < D; ++a) offset[a] = (c >> a) & 1 ? r : -r;
+    if (f(offset)) return true;
+  }
+  return false;
+}
+
+// A vertex site is in the shape if it or a point within 1e-9 spacings of it is: a site on a face
+// at 10 = 40 * 0.25 may round to 10 + 2e-15, and losing it would drop the face's whole layer.
 template <int D>
-ParticleCloud<D> lattice_fill(const Shape<D>& shape, double spacing, const Vec<D>& anchor) {
+bool contains_vertex(const Shape<D>& shape, const Vec<D>& x, double spacing) {
+  if (shape.contains(x)) return true;
+  return any_corner<D>(1e-9 * spacing, [&](const Vec<D>& o) { return shape.contains(x + o); });
+}
+
+// The fraction of the dual cell [x - spacing/2, x + spacing/2]^D inside the shape, on 4^D
+// sub-points at offsets (-3/8, -1/8, 1/8, 3/8) spacing per axis. No sub-point lies on a plane
+// through the vertex or halfway to the next one, so such faces cut off exact halves.
+template <int D>
+double dual_cell_fraction(const Shape<D>& shape, const Vec<D>& x, double spacing) {
+  constexpr int n = 4;
+  int total = 1;
+  for (int a = 0; a < D; ++a) total *= n;
+  int inside = 0;
+  for (int s = 0; s < total; ++s) {
+    Vec<D> y = x;
+    int rest = s;
+    for (int a = 0; a < D; ++a, rest /= n) y[a] += ((rest % n) + 0.5 - 0.5 * n) / n * spacing;
+    if (shape.contains(y)) ++inside;
+  }
+  return static_cast<double>(inside) / total;
+}
+
+}  // namespace
+
+template <int D>
+ParticleCloud<D> lattice_fill(const Shape<D>& shape, double spacing, const Vec<D>& anchor,
+                              LatticePlacement placement) {
   if (!(spacing > 0.0) || !std::isfinite(spacing)) {
     std::ostringstream s;
     s << "lattice fill: spacing must be positive and finite, got " << spacing;
     throw std::invalid_argument(s.str());
   }
   const auto [lower, upper] = shape.bounds();
+  // Sites sit at anchor + (k + shift) * spacing.
+  const bool vertex = placement == LatticePlacement::vertex;
+  const double shift = vertex ? 0.0 : 0.5;
   // Integer lattice range covering the bounding box, one site wider on each side so that
   // rounding in the site coordinates can never drop a site the shape contains.
   std::array<std::int64_t, D> k_lo{}, count{};
   double total = 1.0;
   for (int a = 0; a < D; ++a) {
-    const double lo = std::ceil((lower[a] - anchor[a]) / spacing - 0.5) - 1.0;
-    const double hi = std::floor((upper[a] - anchor[a]) / spacing - 0.5) + 1.0;
+    const double lo = std::ceil((lower[a] - anchor[a]) / spacing - shift) - 1.0;
+    const double hi = std::floor((upper[a] - anchor[a]) / spacing - shift) + 1.0;
     const double n = hi - lo + 1.0;
     if (!std::isfinite(lo) || !std::isfinite(hi)) total = std::numeric_limits<double>::infinity();
     total *= std::max(n, 0.0);
@@ -47,14 +92,27 @@ ParticleCloud<D> lattice_fill(const Shape<D>& shape, double spacing, const Vec<D
   // slice order: the result is the same for any number of threads.
   const auto slices = static_cast<std::size_t>(count[D - 1]);  // 0 if any axis is empty
   std::vector<std::vector<Vec<D>>> found(slices);
+  std::vector<std::vector<double>> volumes(slices);
+  const double cell_volume = std::pow(spacing, D);
   parallel_for_each_index(slices, [&](std::size_t slice) {
     std::array<std::int64_t, D> k{};
     k[D - 1] = static_cast<std::int64_t>(slice);
     while (true) {
       Vec<D> x;
       for (int a = 0; a < D; ++a)
-        x[a] = anchor[a] + (static_cast<double>(k_lo[a] + k[a]) + 0.5) * spacing;
-      if (shape.contains(x)) found[slice].push_back(x);
+        x[a] = anchor[a] + (static_cast<double>(k_lo[a] + k[a]) + shift) * spacing;
+      if (!vertex && shape.contains(x)) {
+        found[slice].push_back(x);
+        volumes[slice].push_back(cell_volume);
+      } else if (vertex && contains_vertex(shape, x, spacing)) {
+        // A site on the shape whose dual cell is all outside (a vertex touching a corner
+        // from outside, a sliver) carries no volume: left out, a particle needs one.
+        const double fraction = dual_cell_fraction(shape, x, spacing);
+        if (fraction > 0.0) {
+          found[slice].push_back(x);
+          volumes[slice].push_back(fraction * cell_volume);
+        }
+      }
       int a = 0;
       for (; a < D - 1; ++a) {
         if (++k[a] < count[a]) break;
@@ -74,12 +132,15 @@ ParticleCloud<D> lattice_fill(const Shape<D>& shape, double spacing, const Vec<D
     throw std::invalid_argument(s.str());
   }
   cloud.positions.reserve(n);
-  for (const auto& f : found) cloud.positions.insert(cloud.positions.end(), f.begin(), f.end());
-  cloud.volumes.assign(n, std::pow(spacing, D));
+  cloud.volumes.reserve(n);
+  for (std::size_t s = 0; s < slices; ++s) {
+    cloud.positions.insert(cloud.positions.end(), found[s].begin(), found[s].end());
+    cloud.volumes.insert(cloud.volumes.end(), volumes[s].begin(), volumes[s].end());
+  }
   return cloud;
 }
 
-template ParticleCloud<2> lattice_fill<2>(const Shape<2>&, double, const Vec<2>&);
-template ParticleCloud<3> lattice_fill<3>(const Shape<3>&, double, const Vec<3>&);
+template ParticleCloud<2> lattice_fill<2>(const Shape<2>&, double, const Vec<2>&, LatticePlacement);
+template ParticleCloud<3> lattice_fill<3>(const Shape<3>&, double, const Vec<3>&, LatticePlacement);
 
 }  // namespace cosph

@@ -1,6 +1,7 @@
-// Fills a shape with particles on a cubic lattice. The lattice is fixed in space by an anchor, so
-// bodies generated with the same anchor and spacing interleave without gaps or overlaps: a
-// particle of one body never sits closer than one spacing to a particle of another.
+// Fills a shape with particles on a cubic lattice, at the cells' centres or at their vertices. The
+// lattice is fixed in space by an anchor, so bodies generated with the same anchor and spacing
+// interleave without gaps or overlaps: a particle of one body never sits closer than one spacing to
+// a particle of another.
 #pragma once
 
 #include "core/types.hpp"
@@ -13,13 +14,26 @@ namespace cosph {
 // the request is almost certainly a unit mistake, and it would exhaust memory anyway.
 inline constexpr double kMaxLatticeSites = 2e8;
 
-// Sites anchor + (k + 1/2) * spacing (k integer, per axis) that the shape contains, each with
-// volume spacing^D. Order: axis 0 (x) fastest, then y, then z, i.e. increasing (z, y, x)
-// lexicographically; the result does not depend on the number of threads.
-// Throws std::invalid_argument if spacing is not positive and finite, if the bounding box holds
-// more than kMaxLatticeSites sites, or if no site lies inside the shape.
+// Where the particles sit on the lattice of cells anchor + [k, k + 1] * spacing (k integer):
+// - cell: at the cells' centres anchor + (k + 1/2) * spacing, each with volume spacing^D (SPH's
+//   usual filling; the outermost particles sit half a spacing inside a lattice-aligned face);
+// - vertex: at the cells' vertices anchor + k * spacing, as the nodes of a finite-element grid
+//   (seed 000 places its particles so), each with the volume of its dual cell
+//   [x - spacing/2, x + spacing/2]^D that lies inside the shape: for a box whose faces lie on the
+//   lattice, half, a quarter and an eighth of spacing^D on its faces, edges and corners, so that
+//   the volumes sum to the box's exactly. The fraction is measured on 4^D sub-points per dual
+//   cell (exact for faces through a vertex or halfway between vertices; across a curved face the
+//   dual cells of the nodes just outside are lost, a first-order deficit); a site within 1e-9
+//   spacings of the shape counts as on it, so that rounding cannot drop a face's layer.
+enum class LatticePlacement { cell, vertex };
+
+// The sites of the placement that the shape contains, with their volumes. Order: axis 0 (x)
+// fastest, then y, then z, i.e. increasing (z, y, x) lexicographically; the result does not depend
+// on the number of threads. Throws std::invalid_argument if spacing is not positive and finite, if
+// the bounding box holds more than kMaxLatticeSites sites, or if no site lies inside the shape.
 template <int D>
 ParticleCloud<D> lattice_fill(const Shape<D>& shape, double spacing,
-                              const Vec<D>& anchor = Vec<D>::Zero());
+                              const Vec<D>& anchor = Vec<D>::Zero(),
+                              LatticePlacement placement = LatticePlacement::cell);
 
 }  // namespace cosph

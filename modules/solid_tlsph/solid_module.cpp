@@ -469,7 +469,10 @@ class SolidModule final : public StaticBodyModule<D> {
   // Surface particles of each pressure region, with their reference area vectors N dA.
   void build_pressures() {
     const auto& volume = particles_.scalar("volume");
-    const double spacing = spec_.body().spacing();
+    // The depth of a surface particle's volume under the face: a cell-centred particle's cell
+    // reaches one spacing in, a vertex particle on the face has half its dual cell inside.
+    const double depth =
+        spec_.body().spacing() * (spec_.body().placement() == "vertex" ? 0.5 : 1.0);
     for (int k = 0; k < spec_.pressures_size(); ++k) {
       const auto& spec = spec_.pressures(k);
       const std::string path = key_ + ".pressures[" + std::to_string(k) + "]";
@@ -487,10 +490,11 @@ class SolidModule final : public StaticBodyModule<D> {
       for (std::size_t m = 0; m < s.particles.size(); ++m) {
         const Index i = s.particles[m];
         if (!shape->contains(X_[i])) continue;
-        // A surface particle carries the face area of its volume, dA = V / spacing, along its
-        // outward normal (the given one for a flat face).
+        // A surface particle carries the face area of its volume, dA = V / depth, along its
+        // outward normal (the given one for a flat face): on a vertex lattice a face's edge and
+        // corner particles, a quarter and an eighth of a cell, carry half and a quarter of dp^2.
         load.particles.push_back(i);
-        load.areas.push_back((volume[i] / spacing) * (given ? normal : s.normals[m]));
+        load.areas.push_back((volume[i] / depth) * (given ? normal : s.normals[m]));
       }
       if (load.particles.empty())
         throw ConfigError(path + ".region", "the region contains no surface particle");

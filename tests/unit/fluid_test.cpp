@@ -383,6 +383,11 @@ TEST(Fluid, BadInputNamesTheKey) {
             std::string::npos);
   EXPECT_NE(message({"modules[0].fluid.initial_pressure=1 +"}).find("initial_pressure"),
             std::string::npos);
+  const std::string vertex = message({"modules[0].fluid.body.placement=vertex"});
+  EXPECT_NE(vertex.find("modules[0].fluid.body.placement"), std::string::npos) << vertex;
+  EXPECT_NE(vertex.find("equal particle volumes"), std::string::npos) << vertex;
+  EXPECT_NE(message({"modules[0].fluid.body.placement=nodes"}).find("placement"),
+            std::string::npos);
   const std::string within = [&] {
     std::vector<std::string> set = kWallForceOutput;
     set.insert(set.end(), {"probes[3].reduce.quantity=maximum", "probes[3].reduce.field=volume"});
