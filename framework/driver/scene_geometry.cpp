@@ -86,6 +86,10 @@ ParticleCloud<D> build_body(const proto::BodySpec& spec, const std::string& key_
   if (spec.has_shape() == spec.has_points_csv())
     throw ConfigError(key_path, "a body needs either a shape or points_csv (not both)");
   if (spec.has_points_csv()) {
+    if (spec.has_placement())
+      throw ConfigError(key_path + ".placement",
+                        "placement applies to a lattice-filled shape; a points_csv body gives "
+                        "its own volumes");
     std::filesystem::path file(spec.points_csv());
     if (file.is_relative()) file = std::filesystem::path(scene_directory) / file;
     try {
@@ -97,9 +101,8 @@ ParticleCloud<D> build_body(const proto::BodySpec& spec, const std::string& key_
   auto shape = build_shape<D>(spec.shape(), key_path + ".shape");
   ParticleCloud<D> cloud;
   try {
-    const auto placement =
-        spec.placement() == "vertex" ? LatticePlacement::vertex : LatticePlacement::cell;
-    cloud = lattice_fill<D>(*shape, spec.spacing(), to_vec<D>(spec.lattice_anchor()), placement);
+    cloud = lattice_fill<D>(*shape, spec.spacing(), to_vec<D>(spec.lattice_anchor()),
+                            lattice_placement(spec));
   } catch (const std::invalid_argument& e) {
     throw ConfigError(key_path, e.what());
   }
@@ -131,6 +134,11 @@ Domain<D> build_domain(const proto::Scene& scene) {
     domain.periodic[a] = a < scene.domain().periodic_size() && scene.domain().periodic(a);
   }
   return domain;
+}
+
+LatticePlacement lattice_placement(const proto::BodySpec& spec) {
+  if (spec.has_points_csv()) return LatticePlacement::cell;
+  return spec.placement() == "vertex" ? LatticePlacement::vertex : LatticePlacement::cell;
 }
 
 Kernel build_kernel(const proto::BodySpec& body, int dimension) {

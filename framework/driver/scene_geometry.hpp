@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/particles.hpp"
+#include "geometry/lattice.hpp"
 #include "geometry/particle_cloud.hpp"
 #include "geometry/shapes.hpp"
 #include "kernels/kernel.hpp"
@@ -23,6 +24,10 @@ ShapePtr<D> build_shape(const proto::Shape& spec, const std::string& key_path);
 template <int D>
 ParticleCloud<D> build_body(const proto::BodySpec& spec, const std::string& key_path,
                             const std::string& scene_directory);
+
+// Where a body's lattice puts its particles (body.placement); a point cloud has none and reads as
+// cell placement (its volumes are its own).
+LatticePlacement lattice_placement(const proto::BodySpec& spec);
 
 template <int D>
 Domain<D> build_domain(const proto::Scene& scene);

@@ -33,25 +33,39 @@ bool contains_vertex(const Shape<D>& shape, const Vec<D>& x, double spacing) {
   return any_corner<D>(1e-9 * spacing, [&](const Vec<D>& o) { return shape.contains(x + o); });
 }
 
+// The sub-point offsets of a dual cell along one axis, in spacings: (-3/8, -1/8, 1/8, 3/8).
+constexpr int kSubPoints = 4;
+constexpr double sub_point_offset(int s) { return (s + 0.5 - 0.5 * kSubPoints) / kSubPoints; }
+
 // The fraction of the dual cell [x - spacing/2, x + spacing/2]^D inside the shape, on 4^D
-// sub-points at offsets (-3/8, -1/8, 1/8, 3/8) spacing per axis. No sub-point lies on a plane
-// through the vertex or halfway to the next one, so such faces cut off exact halves.
+// sub-points. No sub-point lies on a plane through the vertex or halfway to the next one, so such
+// faces cut off exact halves.
 template <int D>
 double dual_cell_fraction(const Shape<D>& shape, const Vec<D>& x, double spacing) {
-  constexpr int n = 4;
   int total = 1;
-  for (int a = 0; a < D; ++a) total *= n;
+  for (int a = 0; a < D; ++a) total *= kSubPoints;
   int inside = 0;
   for (int s = 0; s < total; ++s) {
     Vec<D> y = x;
     int rest = s;
-    for (int a = 0; a < D; ++a, rest /= n) y[a] += ((rest % n) + 0.5 - 0.5 * n) / n * spacing;
+    for (int a = 0; a < D; ++a, rest /= kSubPoints)
+      y[a] += sub_point_offset(rest % kSubPoints) * spacing;
     if (shape.contains(y)) ++inside;
   }
   return static_cast<double>(inside) / total;
 }
 
 }  // namespace
+
+template <int D>
+double dual_cell_depth(const Shape<D>& shape, const Vec<D>& x, const Vec<D>& direction,
+                       double spacing) {
+  int inside = 0;
+  for (int s = 0; s < kSubPoints; ++s)
+    if (contains_vertex<D>(shape, x + (sub_point_offset(s) * spacing) * direction, spacing))
+      ++inside;
+  return static_cast<double>(inside) / kSubPoints * spacing;
+}
 
 template <int D>
 ParticleCloud<D> lattice_fill(const Shape<D>& shape, double spacing, const Vec<D>& anchor,
@@ -140,6 +154,8 @@ ParticleCloud<D> lattice_fill(const Shape<D>& shape, double spacing, const Vec<D
   return cloud;
 }
 
+template double dual_cell_depth<2>(const Shape<2>&, const Vec<2>&, const Vec<2>&, double);
+template double dual_cell_depth<3>(const Shape<3>&, const Vec<3>&, const Vec<3>&, double);
 template ParticleCloud<2> lattice_fill<2>(const Shape<2>&, double, const Vec<2>&, LatticePlacement);
 template ParticleCloud<3> lattice_fill<3>(const Shape<3>&, double, const Vec<3>&, LatticePlacement);
 

@@ -36,4 +36,16 @@ ParticleCloud<D> lattice_fill(const Shape<D>& shape, double spacing,
                               const Vec<D>& anchor = Vec<D>::Zero(),
                               LatticePlacement placement = LatticePlacement::cell);
 
+// The depth of a vertex site's dual cell inside the shape along a unit direction (a surface's
+// outward normal): the length of the segment x + t direction, |t| <= spacing/2, that the shape
+// contains, measured on the 4 sub-points per axis that measure the dual cell's volume (each
+// within 1e-9 spacings of the shape counts, as a site does: the segment of a node on an edge runs
+// along a face). With the
+// volume V of lattice_fill, V / depth is the site's share of the face: exact for a face
+// perpendicular to an axis wherever it falls between two vertices (an edge site's share is half
+// of spacing^(D-1) when the edge lies on a vertex, more when the cell reaches past it).
+template <int D>
+double dual_cell_depth(const Shape<D>& shape, const Vec<D>& x, const Vec<D>& direction,
+                       double spacing);
+
 }  // namespace cosph

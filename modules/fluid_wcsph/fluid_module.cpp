@@ -92,7 +92,7 @@ class FluidModule final : public Module {
   void initialize() override {
     // The fluid's particles move off any lattice at once; what they need is one mass each, so that
     // the density summation and its reinitialisation read rho0 in the bulk.
-    if (spec_.body().placement() == "vertex")
+    if (lattice_placement(spec_.body()) == LatticePlacement::vertex)
       throw ConfigError(
           key_ + ".body.placement",
           "the fluid needs equal particle volumes (placement: cell); vertex placement "

@@ -468,11 +468,6 @@ class SolidModule final : public StaticBodyModule<D> {
 
   // Surface particles of each pressure region, with their reference area vectors N dA.
   void build_pressures() {
-    const auto& volume = particles_.scalar("volume");
-    // The depth of a surface particle's volume under the face: a cell-centred particle's cell
-    // reaches one spacing in, a vertex particle on the face has half its dual cell inside.
-    const double depth =
-        spec_.body().spacing() * (spec_.body().placement() == "vertex" ? 0.5 : 1.0);
     for (int k = 0; k < spec_.pressures_size(); ++k) {
       const auto& spec = spec_.pressures(k);
       const std::string path = key_ + ".pressures[" + std::to_string(k) + "]";
@@ -490,16 +485,36 @@ class SolidModule final : public StaticBodyModule<D> {
       for (std::size_t m = 0; m < s.particles.size(); ++m) {
         const Index i = s.particles[m];
         if (!shape->contains(X_[i])) continue;
-        // A surface particle carries the face area of its volume, dA = V / depth, along its
-        // outward normal (the given one for a flat face): on a vertex lattice a face's edge and
-        // corner particles, a quarter and an eighth of a cell, carry half and a quarter of dp^2.
+        const Vec<D> n = given ? normal : s.normals[m];
         load.particles.push_back(i);
-        load.areas.push_back((volume[i] / depth) * (given ? normal : s.normals[m]));
+        load.areas.push_back(face_area(i, n, path) * n);
       }
       if (load.particles.empty())
         throw ConfigError(path + ".region", "the region contains no surface particle");
       pressures_.push_back(std::move(load));
     }
+  }
+
+  // The face area dA a surface particle carries, its volume over the depth of that volume under
+  // the face: a cell-centred particle's cell reaches one spacing in; a vertex particle's dual
+  // cell reaches as far as the body's shape holds it along the normal (half a spacing for a node
+  // on the face, more for a face between two layers of nodes), so that on a vertex lattice a
+  // face's edge and corner particles carry their share of the face.
+  double face_area(Index i, const Vec<D>& normal, const std::string& path) {
+    const double volume = particles_.scalar("volume")[i];
+    const double spacing = spec_.body().spacing();
+    if (lattice_placement(spec_.body()) != LatticePlacement::vertex) return volume / spacing;
+    if (!body_shape_) body_shape_ = build_shape<D>(spec_.body().shape(), key_ + ".body.shape");
+    const double depth = dual_cell_depth<D>(*body_shape_, X_[i], normal, spacing);
+    if (!(depth > 0.0)) {
+      std::ostringstream where;
+      where << X_[i].transpose();
+      throw ConfigError(path + ".normal",
+                        "the normal points out of the body on both sides of the surface particle "
+                        "at X = (" +
+                            where.str() + ")");
+    }
+    return volume / depth;
   }
 
   // Holds constrained particles at time t (before an acceleration is computed from u, v).
@@ -720,6 +735,7 @@ class SolidModule final : public StaticBodyModule<D> {
   Vec<D> body_force_ = Vec<D>::Zero();
   std::vector<Vec<D>> external_force_;
   mutable std::optional<Surface<D>> surface_;
+  ShapePtr<D> body_shape_;                           // built for vertex pressure areas only
   std::vector<Vec<D>> u0_, v0_, us_, vs_, du_, dv_;  // RK4 stages (RK4 only)
   static constexpr long long kStiffnessInterval = 1000;
   double stiffness_eigenvalue_ = 0.0;

@@ -275,6 +275,14 @@ TEST(CommandLine, ExitCodesAndMessages) {
   EXPECT_EQ(cli({"check", write_scene(temp_dir("cli_csv"), csv_scene)}, &err), 2);
   EXPECT_NE(err.find("missing.csv"), std::string::npos) << err;
   EXPECT_NE(err.find("points_csv"), std::string::npos) << err;
+  // A lattice placement on a point cloud, whose volumes are its own.
+  EXPECT_EQ(cli({"check", write_scene(temp_dir("cli_csv"), csv_scene), "--set",
+                 "modules[0].diffusion.body.placement=vertex"},
+                &err),
+            2);
+  EXPECT_NE(err.find("modules[0].diffusion.body.placement: placement applies to a lattice"),
+            std::string::npos)
+      << err;
   // A bad expression names its key.
   EXPECT_EQ(cli({"check", scene, "--set", "modules[0].diffusion.initial=exp(-q)"}, &err), 2);
   EXPECT_NE(err.find("modules[0].diffusion.initial"), std::string::npos) << err;
