@@ -33,6 +33,9 @@ struct ModuleInfo {
   std::vector<std::string> children;  // modules a coupler owns
   int dimension = 0;                  // 2 or 3
   double spacing = 0.0;               // particle spacing of its main body (0: none)
+  // Counters of what the run did, for the run summary (a steady-state solver's iterations and
+  // residual); empty for most modules.
+  std::map<std::string, double> statistics;
 };
 
 // Data through a port: `points` entries of each named array, `components` doubles per entry.

@@ -109,7 +109,17 @@ std::string RunSummary::to_json() const {
       << ", \"advance_seconds\": " << json_number(m.advance_seconds) << ", \"features\": [";
     for (std::size_t f = 0; f < m.features.size(); ++f)
       j << (f ? ", " : "") << "\"" << json_escape(m.features[f]) << "\"";
-    j << "]}";
+    j << "]";
+    if (!m.statistics.empty()) {
+      j << ", \"statistics\": {";
+      bool first = true;
+      for (const auto& [key, value] : m.statistics) {
+        j << (first ? "" : ", ") << "\"" << json_escape(key) << "\": " << json_number(value);
+        first = false;
+      }
+      j << "}";
+    }
+    j << "}";
   }
   j << "\n  ],\n  \"couplers\": [";
   for (std::size_t k = 0; k < couplers.size(); ++k) {
@@ -506,7 +516,8 @@ RunSummary Simulation::run() {
   for (const TimedModule* m : tree_.modules) {
     const ModuleInfo info = m->info();
     summary.modules.push_back(
-        {info.name, info.type, m->particle_count(), info.active_features, m->advance_seconds()});
+        {info.name, info.type, m->particle_count(), info.active_features, m->advance_seconds(),
+         info.statistics});
     summary.particles += m->particle_count();
   }
   for (std::size_t c = 0; c < tree_.couplers.size(); ++c) {

@@ -32,6 +32,7 @@ struct ModuleTiming {
   std::size_t particles = 0;
   std::vector<std::string> features;
   double advance_seconds = 0.0;
+  std::map<std::string, double> statistics;
 };
 
 // A coupler's time: its whole step, and its own share (exchange and mapping: the step less its

@@ -14,6 +14,7 @@
 #include "geometry/surface.hpp"
 #include "solid_tlsph/fibre_frames.hpp"
 #include "solid_tlsph/material_model.hpp"
+#include "solid_tlsph/static_equilibrium.hpp"
 #include "solid_tlsph/tlsph_operators.hpp"
 
 namespace cosph {
@@ -44,6 +45,7 @@ class SolidModule final : public StaticBodyModule<D> {
     for (int a = 0; a < spec_.initial_velocity_size(); ++a)
       initial_velocity_.push_back(
           parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));
+    if (spec_.has_steady_state()) check_steady_state_spec();
   }
 
   ModuleInfo info() const override {
@@ -65,10 +67,15 @@ class SolidModule final : public StaticBodyModule<D> {
     if (spec_.gradient_correction() == "quadratic")
       f.push_back("quadratic gradient correction (" + std::to_string(pairs_.quadratic_particles()) +
                   " of " + std::to_string(X_.size()) + " particles)");
-    f.push_back(spec_.integrator() == "rk4" ? "RK4 integrator" : "position Verlet integrator");
+    if (steady())
+      f.push_back("steady state: Newton, " + std::to_string(spec_.steady_state().load_steps()) +
+                  " load step(s) over the ramp, relative tolerance " +
+                  short_number(spec_.steady_state().tolerance()));
+    else
+      f.push_back(spec_.integrator() == "rk4" ? "RK4 integrator" : "position Verlet integrator");
     if (spec_.has_artificial_viscosity()) f.push_back("artificial viscosity");
     if (spec_.has_hourglass_control()) f.push_back("hourglass control");
-    if (spec_.damping() > 0.0) f.push_back("mass-proportional damping");
+    if (spec_.damping() > 0.0 && !steady()) f.push_back("mass-proportional damping");
     if (spec_.load_ramp_time() > 0.0) f.push_back("load ramp");
     if (spec_.body_force_size() > 0) f.push_back("body force");
     if (spec_.constraints_size() > 0) f.push_back("constraints");
@@ -76,6 +83,14 @@ class SolidModule final : public StaticBodyModule<D> {
     if (spec_.has_active_tension()) f.push_back("prescribed active tension");
     if (has_frames()) f.push_back("fibre frames");
     for (const auto& o : spec_.outputs()) f.push_back("output " + o);
+    if (steady()) {
+      info.statistics["load_increments"] = double(steady_increments_);
+      info.statistics["increment_bisections"] = double(steady_bisections_);
+      info.statistics["newton_iterations"] = double(newton_iterations_);
+      info.statistics["relative_residual"] = steady_residual_;
+      info.statistics["factorisation_seconds"] =
+          equilibrium_ ? equilibrium_->factorisation_seconds() : 0.0;
+    }
     return info;
   }
 
@@ -139,12 +154,18 @@ class SolidModule final : public StaticBodyModule<D> {
     }
     auto& u = particles_.vector("displacement");
     apply_constraints(0.0, u, v);
-    if (!spec_.has_time_step()) update_stiffness_eigenvalue();
+    if (steady()) build_static_equilibrium();
+    if (!spec_.has_time_step() && !steady()) update_stiffness_eigenvalue();
     compute_acceleration(0.0, u, v, particles_.vector("acceleration"));
     prepare_output();
   }
 
   double max_dt() const override {
+    if (steady()) {
+      // A load increment during the ramp; after it, the whole rest of the run in one step.
+      const double ramp = spec_.load_ramp_time();
+      return time_ < ramp * (1.0 - 1e-12) ? ramp / spec_.steady_state().load_steps() : INFINITY;
+    }
     if (spec_.has_time_step()) return spec_.time_step();
     const auto& v = particles_.vector("velocity");
     const auto& a = particles_.vector("acceleration");
@@ -171,11 +192,15 @@ class SolidModule final : public StaticBodyModule<D> {
   }
 
   void advance(double dt) override {
-    if (steps_ > 0 && steps_ % kStiffnessInterval == 0) update_stiffness_eigenvalue();
-    if (spec_.integrator() == "rk4")
-      advance_rk4(dt);
-    else
-      advance_verlet(dt);
+    if (steady()) {
+      advance_steady(dt);
+    } else {
+      if (steps_ > 0 && steps_ % kStiffnessInterval == 0) update_stiffness_eigenvalue();
+      if (spec_.integrator() == "rk4")
+        advance_rk4(dt);
+      else
+        advance_verlet(dt);
+    }
     time_ += dt;
     ++steps_;
   }
@@ -289,6 +314,12 @@ class SolidModule final : public StaticBodyModule<D> {
     state.scalars["time"] = time_;
     state.scalars["stiffness_eigenvalue"] = stiffness_eigenvalue_;
     state.integers["steps"] = steps_;
+    if (steady()) {
+      state.integers["load_increments"] = steady_increments_;
+      state.integers["increment_bisections"] = steady_bisections_;
+      state.integers["newton_iterations"] = newton_iterations_;
+      state.scalars["relative_residual"] = steady_residual_;
+    }
   }
 
   void load(const StateRecord& state) override {
@@ -309,6 +340,12 @@ class SolidModule final : public StaticBodyModule<D> {
       throw RuntimeError("module '" + name_ + "': checkpoint's stiffness_eigenvalue " +
                          std::to_string(stiffness_eigenvalue_) + " is not an eigenvalue");
     steps_ = read.integer("steps");
+    if (steady()) {
+      steady_increments_ = read.integer("load_increments");
+      steady_bisections_ = read.integer("increment_bisections");
+      newton_iterations_ = read.integer("newton_iterations");
+      steady_residual_ = read.scalar("relative_residual");
+    }
     const auto& u = particles_.vector("displacement");
     auto& x = particles_.vector("position");
     for (std::size_t i = 0; i < u.size(); ++i) x[i] = X_[i] + u[i];
@@ -718,6 +755,154 @@ class SolidModule final : public StaticBodyModule<D> {
     }
   }
 
+  // ---- Steady state (static equilibrium by Newton, static_equilibrium.hpp) ----
+
+  bool steady() const { return spec_.has_steady_state(); }
+
+  static std::string short_number(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  }
+
+  // What a static solve cannot honour is refused with its key: it has no velocities, and the
+  // hourglass forces have no tangent here.
+  void check_steady_state_spec() const {
+    const std::string why = " is not allowed with steady_state (a static solve has no velocities)";
+    if (spec_.initial_velocity_size() > 0)
+      throw ConfigError(key_ + ".initial_velocity", "initial_velocity" + why);
+    if (spec_.has_time_step())
+      throw ConfigError(key_ + ".time_step",
+                        "time_step is not used with steady_state: its steps are the load "
+                        "increments (steady_state.load_steps over load_ramp_time)");
+    if (spec_.has_hourglass_control())
+      throw ConfigError(key_ + ".hourglass_control",
+                        "hourglass control is not supported with steady_state (its forces have "
+                        "no tangent in the Newton solve)");
+    for (int k = 0; k < spec_.constraints_size(); ++k)
+      if (spec_.constraints(k).has_velocity())
+        throw ConfigError(key_ + ".constraints[" + std::to_string(k) + "].velocity",
+                          "a prescribed velocity" + why + "; prescribe a displacement");
+  }
+
+  void build_static_equilibrium() {
+    const std::size_t n = X_.size();
+    prescribed_.assign(n * D, 0);
+    for (const auto& c : constraints_)
+      for (Index i : c.particles)
+        for (int a = 0; a < D; ++a)
+          if (c.kind != ConstraintKind::Fixed || c.components[a]) prescribed_[i * D + a] = 1;
+    equilibrium_.emplace(pairs_, particles_.scalar("volume"), prescribed_);
+    zero_velocity_.assign(n, Vec<D>::Zero());
+    internal_force_.assign(n, Vec<D>::Zero());
+    loaded_slot_.assign(n, -1);
+    for (const auto& load : pressures_)
+      for (Index i : load.particles)
+        if (loaded_slot_[i] < 0) {
+          loaded_slot_[i] = static_cast<long long>(loaded_particles_.size());
+          loaded_particles_.push_back(i);
+        }
+    static_body_.prescribe = [this](double t, std::vector<Vec<D>>& u) {
+      apply_constraints(t, u, zero_velocity_);
+    };
+    static_body_.force = [this](double t, const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f) {
+      return static_force(t, u, f);
+    };
+    static_body_.tangents = [this](double t, std::vector<MaterialTangent<D>>& C,
+                                   std::vector<Index>& loaded, std::vector<ForceTangent<D>>& L) {
+      static_tangents(t, C, loaded, L);
+    };
+  }
+
+  // The net force m a at rest (v = 0), and the scale max(|f_internal|, |f_external|) over the
+  // free components, f_internal = V_i (stress divergence).
+  double static_force(double t, const std::vector<Vec<D>>& u, std::vector<Vec<D>>& force) {
+    compute_acceleration(t, u, zero_velocity_, force);
+    const auto& mass = particles_.scalar("mass");
+    const auto& volume = particles_.scalar("volume");
+    parallel_for_each_index(u.size(), [&](std::size_t i) {
+      force[i] *= mass[i];
+      internal_force_[i] = volume[i] * pair_stress_divergence<D>(pairs_, P_, i);
+    });
+    auto free_norm = [&](auto&& component) {
+      return std::sqrt(deterministic_sum(u.size(), 0.0, [&](std::size_t i) {
+        double sum = 0.0;
+        for (int a = 0; a < D; ++a)
+          if (!prescribed_[i * D + a]) sum += component(i, a) * component(i, a);
+        return sum;
+      }));
+    };
+    const double internal = free_norm([&](std::size_t i, int a) { return internal_force_[i][a]; });
+    const double external = free_norm(
+        [&](std::size_t i, int a) { return force[i][a] - internal_force_[i][a]; });
+    return std::max(internal, external);
+  }
+
+  // dP/dF of every particle and df/dF of the follower pressure's particles, at F_ (the last
+  // static_force call), by central differences of the laws themselves.
+  void static_tangents(double t, std::vector<MaterialTangent<D>>& C, std::vector<Index>& loaded,
+                       std::vector<ForceTangent<D>>& L) {
+    const std::size_t n = X_.size();
+    C.resize(n);
+    parallel_for_each_index(n, [&](std::size_t i) {
+      const Mat<D> frame = frames_.empty() ? Mat<D>::Identity() : frames_[i];
+      C[i] = derivative_in_F<D, D * D>(
+          [&](const Mat<D>& F) { return flatten<D>(first_piola(i, F, frame)); }, F_[i]);
+    });
+    loaded = loaded_particles_;
+    L.assign(loaded.size(), ForceTangent<D>::Zero());
+    const double factor = load_factor(t);
+    for (const auto& load : pressures_)
+      for (std::size_t k = 0; k < load.particles.size(); ++k) {
+        const Index i = load.particles[k];
+        const double p = factor * load.value.evaluate(Base::space_time(X_[i], t));
+        const Vec<D> area = load.areas[k];
+        L[static_cast<std::size_t>(loaded_slot_[i])] += derivative_in_F<D, D>(
+            [&](const Mat<D>& F) -> Vec<D> {
+              return -p * F.determinant() * (F.inverse().transpose() * area);
+            },
+            F_[i]);
+      }
+  }
+
+  // One step is a load increment to t + dt, bisected where Newton does not converge.
+  void advance_steady(double dt) {
+    auto& u = particles_.vector("displacement");
+    solve_increment(time_, time_ + dt, u, 0);
+    static_force(time_ + dt, u, particles_.vector("acceleration"));  // F, P of the solution
+    auto& x = particles_.vector("position");
+    for (std::size_t i = 0; i < u.size(); ++i) x[i] = X_[i] + u[i];
+    std::fill(particles_.vector("velocity").begin(), particles_.vector("velocity").end(),
+              Vec<D>::Zero());
+    std::fill(particles_.vector("acceleration").begin(), particles_.vector("acceleration").end(),
+              Vec<D>::Zero());
+  }
+
+  void solve_increment(double t0, double t1, std::vector<Vec<D>>& u, int depth) {
+    constexpr int kMaxBisections = 6;
+    const std::vector<Vec<D>> start = u;
+    NewtonSettings settings{spec_.steady_state().tolerance(),
+                            spec_.steady_state().max_iterations()};
+    const NewtonOutcome outcome = equilibrium_->solve(t1, u, static_body_, settings);
+    newton_iterations_ += outcome.iterations;
+    steady_residual_ = outcome.relative_residual;
+    if (outcome.converged) {
+      ++steady_increments_;
+      return;
+    }
+    if (depth == kMaxBisections)
+      throw RuntimeError("module '" + name_ + "': the steady state at t = " + short_number(t1) +
+                         " did not converge (relative residual " +
+                         short_number(outcome.relative_residual) + " after " +
+                         std::to_string(outcome.iterations) + " Newton iterations, load increment " +
+                         short_number(t1 - t0) + " after " + std::to_string(kMaxBisections) +
+                         " bisections); the load may exceed what the body can carry");
+    ++steady_bisections_;
+    u = start;
+    solve_increment(t0, 0.5 * (t0 + t1), u, depth + 1);
+    solve_increment(0.5 * (t0 + t1), t1, u, depth + 1);
+  }
+
   proto::SolidSpec spec_;
   MaterialModel<D> material_;
   // 2D is plane strain: the out-of-plane stress sigma_zz that holds F_zz = 1 enters the von Mises
@@ -738,6 +923,15 @@ class SolidModule final : public StaticBodyModule<D> {
   ShapePtr<D> body_shape_;                           // built for vertex pressure areas only
   std::vector<Vec<D>> u0_, v0_, us_, vs_, du_, dv_;  // RK4 stages (RK4 only)
   static constexpr long long kStiffnessInterval = 1000;
+  // Steady state only.
+  std::optional<StaticEquilibrium<D>> equilibrium_;
+  typename StaticEquilibrium<D>::Body static_body_;
+  std::vector<char> prescribed_;             // per component: held by a constraint
+  std::vector<Vec<D>> zero_velocity_, internal_force_;
+  std::vector<Index> loaded_particles_;      // particles under a follower pressure
+  std::vector<long long> loaded_slot_;       // their index in loaded_particles_ (-1: none)
+  long long steady_increments_ = 0, steady_bisections_ = 0, newton_iterations_ = 0;
+  double steady_residual_ = 0.0;
   double stiffness_eigenvalue_ = 0.0;
 };
 

@@ -1,0 +1,89 @@
+// Static equilibrium of a total-Lagrangian SPH body at one load: Newton on the free
+// displacement components (newton_solver.hpp) with the tangent of static_tangent.hpp. The body
+// supplies its forces and the derivatives of its stresses through callbacks, so that this class
+// knows the unknowns and the linear algebra and nothing of the material or the loads.
+#pragma once
+
+#include <Eigen/Dense>
+#include <functional>
+#include <vector>
+
+#include "solid_tlsph/newton_solver.hpp"
+#include "solid_tlsph/static_tangent.hpp"
+
+namespace cosph {
+
+// d/dF of a function of F, by central differences of step eps in each entry (the laws' stresses
+// are smooth in F; eps = 1e-6 leaves a relative error near 1e-10, below the solver's tolerance).
+template <int D, int Rows>
+Eigen::Matrix<double, Rows, D * D> derivative_in_F(
+    const std::function<Eigen::Matrix<double, Rows, 1>(const Mat<D>&)>& f, const Mat<D>& F,
+    double eps = 1e-6) {
+  Eigen::Matrix<double, Rows, D * D> d;
+  for (int a = 0; a < D; ++a)
+    for (int b = 0; b < D; ++b) {
+      Mat<D> plus = F, minus = F;
+      plus(a, b) += eps;
+      minus(a, b) -= eps;
+      d.col(a * D + b) = (f(plus) - f(minus)) / (2.0 * eps);
+    }
+  return d;
+}
+
+// P flattened with entry (a, b) at a * D + b, the layout of MaterialTangent.
+template <int D>
+Eigen::Matrix<double, D * D, 1> flatten(const Mat<D>& P) {
+  Eigen::Matrix<double, D * D, 1> p;
+  for (int a = 0; a < D; ++a)
+    for (int b = 0; b < D; ++b) p[a * D + b] = P(a, b);
+  return p;
+}
+
+template <int D>
+class StaticEquilibrium {
+ public:
+  struct Body {
+    // Sets the prescribed components of u at load time t (clamps, fixed components, prescribed
+    // displacements).
+    std::function<void(double t, std::vector<Vec<D>>& u)> prescribe;
+    // The net force on every particle at displacements u (zero on prescribed components) and
+    // the scale of the forces in balance (|f_internal| and |f_external| over the free
+    // components); keeps F_i of u for the tangent callback.
+    std::function<double(double t, const std::vector<Vec<D>>& u, std::vector<Vec<D>>& force)>
+        force;
+    // C_i = dP/dF for every particle and L_i = df_i/dF_i for the particles with a force of their
+    // own (the follower pressure), at the F of the last force call.
+    std::function<void(double t, std::vector<MaterialTangent<D>>& C, std::vector<Index>& loaded,
+                       std::vector<ForceTangent<D>>& L)>
+        tangents;
+  };
+
+  // prescribed[i * D + a]: component a of particle i is prescribed at every load.
+  StaticEquilibrium(const ReferencePairs<D>& pairs, const std::vector<double>& volume,
+                    const std::vector<char>& prescribed);
+
+  // Solves for u at load time t, starting from the u given (prescribed components are set
+  // first). On failure u holds the last accepted iterate.
+  NewtonOutcome solve(double t, std::vector<Vec<D>>& u, const Body& body,
+                      const NewtonSettings& settings);
+
+  long long unknowns() const { return unknowns_; }
+  std::size_t tangent_blocks() const { return pattern_.column.size(); }
+  double factorisation_seconds() const { return solver_.factorisation_seconds(); }
+
+ private:
+  void scatter(const Eigen::VectorXd& x, std::vector<Vec<D>>& u) const;
+
+  const ReferencePairs<D>& pairs_;
+  std::vector<double> volume_;
+  std::vector<long long> dof_;
+  long long unknowns_ = 0;
+  TangentPattern pattern_;
+  NewtonSolver solver_;
+  std::vector<MaterialTangent<D>> C_;
+  std::vector<Index> loaded_;
+  std::vector<ForceTangent<D>> L_;
+  std::vector<Vec<D>> force_;
+};
+
+}  // namespace cosph

@@ -1,0 +1,186 @@
+#include "solid_tlsph/static_tangent.hpp"
+
+#include <algorithm>
+
+#include "core/parallel.hpp"
+
+namespace cosph {
+
+namespace {
+
+// The particles whose displacements enter F_i: i itself first, then its neighbours in list order.
+// Slot s of particle i is pair offset[i] + s - 1 for s >= 1.
+template <int D>
+Vec<D> coefficient(const ReferencePairs<D>& pairs, std::size_t i, std::size_t slot) {
+  if (slot == 0) return -pairs.gradient_sum[i];
+  return pairs.gradient[pairs.neighbours.offset[i] + slot - 1];
+}
+
+template <int D>
+Index node(const ReferencePairs<D>& pairs, std::size_t i, std::size_t slot) {
+  return slot == 0 ? static_cast<Index>(i) : pairs.neighbours.index[pairs.neighbours.offset[i] + slot - 1];
+}
+
+std::size_t slots(const NeighbourList& nl, std::size_t i) { return nl.offset[i + 1] - nl.offset[i] + 1; }
+
+// Position of column k in row j of the pattern (present by construction).
+std::size_t find_column(const TangentPattern& pattern, std::size_t j, Index k) {
+  const auto begin = pattern.column.begin() + static_cast<std::ptrdiff_t>(pattern.offset[j]);
+  const auto end = pattern.column.begin() + static_cast<std::ptrdiff_t>(pattern.offset[j + 1]);
+  return static_cast<std::size_t>(std::lower_bound(begin, end, k) - pattern.column.begin());
+}
+
+}  // namespace
+
+template <int D>
+TangentPattern build_tangent_pattern(const ReferencePairs<D>& pairs) {
+  const NeighbourList& nl = pairs.neighbours;
+  const std::size_t n = nl.particle_count();
+  std::vector<std::vector<Index>> rows(n);
+  parallel_for_each_index(n, [&](std::size_t j) {
+    std::vector<Index>& row = rows[j];
+    row.push_back(static_cast<Index>(j));
+    for (Index i : nl.of(j)) {
+      row.push_back(i);
+      for (Index k : nl.of(i)) row.push_back(k);
+    }
+    for (Index k : nl.of(j)) row.push_back(k);
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+  });
+  TangentPattern pattern;
+  pattern.offset.assign(n + 1, 0);
+  for (std::size_t j = 0; j < n; ++j) pattern.offset[j + 1] = pattern.offset[j] + rows[j].size();
+  pattern.column.resize(pattern.offset[n]);
+  parallel_for_each_index(n, [&](std::size_t j) {
+    std::copy(rows[j].begin(), rows[j].end(),
+              pattern.column.begin() + static_cast<std::ptrdiff_t>(pattern.offset[j]));
+  });
+  return pattern;
+}
+
+template <int D>
+Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
+                                             const TangentPattern& pattern,
+                                             const std::vector<double>& volume,
+                                             const std::vector<MaterialTangent<D>>& C,
+                                             const std::vector<Index>& force_tangent_particles,
+                                             const std::vector<ForceTangent<D>>& force_tangents,
+                                             const std::vector<long long>& dof,
+                                             long long unknowns) {
+  using Block = Mat<D>;
+  using Contracted = Eigen::Matrix<double, D * D, D>;
+  const NeighbourList& nl = pairs.neighbours;
+  const std::size_t n = nl.particle_count();
+
+  // Q_ik = C_i H_ik per slot: Q[(a, b), c] = sum_d C_i[(a, b), (c, d)] c_ik[d].
+  std::vector<std::size_t> slot_offset(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) slot_offset[i + 1] = slot_offset[i] + slots(nl, i);
+  std::vector<Contracted> Q(slot_offset[n]);
+  // Where j sits among i's slots, per pair (i, j): the reverse lookup of the gather below.
+  std::vector<std::size_t> slot_of_self_in(nl.pair_count());
+  parallel_for_each_index(n, [&](std::size_t i) {
+    for (std::size_t s = 0; s < slots(nl, i); ++s) {
+      const Vec<D> c = coefficient(pairs, i, s);
+      Contracted& q = Q[slot_offset[i] + s];
+      for (int col = 0; col < D; ++col) {
+        Eigen::Matrix<double, D * D, 1> sum = Eigen::Matrix<double, D * D, 1>::Zero();
+        for (int d = 0; d < D; ++d) sum += C[i].col(col * D + d) * c[d];
+        q.col(col) = sum;
+      }
+    }
+    for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
+      const Index j = nl.index[k];
+      std::size_t back = nl.offset[j];
+      while (nl.index[back] != Index(i)) ++back;  // symmetric lists: present
+      slot_of_self_in[k] = back - nl.offset[j] + 1;
+    }
+  });
+  std::vector<long long> own_force(n, -1);
+  for (std::size_t m = 0; m < force_tangent_particles.size(); ++m)
+    own_force[force_tangent_particles[m]] = static_cast<long long>(m);
+
+  // Row j of K: sum over the particles i whose F depends on u_j (j itself and its neighbours).
+  std::vector<Block> K(pattern.column.size(), Block::Zero());
+  parallel_for_each_index(n, [&](std::size_t j) {
+    auto add_particle = [&](std::size_t i, const Vec<D>& c_ij) {
+      for (std::size_t s = 0; s < slots(nl, i); ++s) {
+        const Contracted& q = Q[slot_offset[i] + s];
+        Block b = Block::Zero();
+        for (int a = 0; a < D; ++a)
+          for (int bb = 0; bb < D; ++bb) b.row(a) += c_ij[bb] * q.row(a * D + bb);
+        K[find_column(pattern, j, node(pairs, i, s))] += volume[i] * b;
+      }
+    };
+    add_particle(j, coefficient(pairs, j, 0));
+    for (std::size_t k = nl.offset[j]; k < nl.offset[j + 1]; ++k) {
+      const Index i = nl.index[k];
+      add_particle(i, coefficient(pairs, i, slot_of_self_in[k]));
+    }
+    if (own_force[j] >= 0) {
+      const ForceTangent<D>& L = force_tangents[static_cast<std::size_t>(own_force[j])];
+      for (std::size_t s = 0; s < slots(nl, j); ++s) {
+        const Vec<D> c = coefficient(pairs, j, s);
+        Block b = Block::Zero();
+        for (int col = 0; col < D; ++col)
+          for (int d = 0; d < D; ++d) b.col(col) += L.col(col * D + d) * c[d];
+        K[find_column(pattern, j, node(pairs, j, s))] -= b;
+      }
+    }
+  });
+
+  // The symmetric part on the free unknowns, in compressed column storage. Column dof(j, a) holds
+  // rows dof(k, c) of the blocks (j, k), k ascending: K_s(k, j)[c][a] = K_s(j, k)[a][c].
+  std::vector<long long> column_start(static_cast<std::size_t>(unknowns) + 1, 0);
+  std::vector<long long> row_count(n, 0);
+  parallel_for_each_index(n, [&](std::size_t j) {
+    long long count = 0;
+    for (std::size_t p = pattern.offset[j]; p < pattern.offset[j + 1]; ++p)
+      for (int c = 0; c < D; ++c) count += dof[pattern.column[p] * D + c] >= 0 ? 1 : 0;
+    row_count[j] = count;
+  });
+  for (std::size_t j = 0; j < n; ++j)
+    for (int a = 0; a < D; ++a) {
+      const long long col = dof[j * D + a];
+      if (col >= 0) column_start[static_cast<std::size_t>(col) + 1] = row_count[j];
+    }
+  for (long long c = 0; c < unknowns; ++c)
+    column_start[static_cast<std::size_t>(c) + 1] += column_start[static_cast<std::size_t>(c)];
+  Eigen::SparseMatrix<double> matrix(unknowns, unknowns);
+  matrix.resizeNonZeros(static_cast<Eigen::Index>(column_start.back()));
+  for (long long c = 0; c <= unknowns; ++c)
+    matrix.outerIndexPtr()[c] = static_cast<int>(column_start[static_cast<std::size_t>(c)]);
+  int* const inner = matrix.innerIndexPtr();
+  double* const value = matrix.valuePtr();
+  parallel_for_each_index(n, [&](std::size_t j) {
+    for (int a = 0; a < D; ++a) {
+      const long long col = dof[j * D + a];
+      if (col < 0) continue;
+      long long at = column_start[static_cast<std::size_t>(col)];
+      for (std::size_t p = pattern.offset[j]; p < pattern.offset[j + 1]; ++p) {
+        const Index k = pattern.column[p];
+        const Block& forward = K[p];
+        const Block& backward = K[find_column(pattern, k, static_cast<Index>(j))];
+        for (int c = 0; c < D; ++c) {
+          const long long row = dof[k * D + c];
+          if (row < 0) continue;
+          inner[at] = static_cast<int>(row);
+          value[at] = 0.5 * (forward(a, c) + backward(c, a));
+          ++at;
+        }
+      }
+    }
+  });
+  return matrix;
+}
+
+#define COSPH_INSTANTIATE_STATIC_TANGENT(D)                                                      \
+  template TangentPattern build_tangent_pattern<D>(const ReferencePairs<D>&);                    \
+  template Eigen::SparseMatrix<double> assemble_tangent<D>(                                      \
+      const ReferencePairs<D>&, const TangentPattern&, const std::vector<double>&,               \
+      const std::vector<MaterialTangent<D>>&, const std::vector<Index>&,                         \
+      const std::vector<ForceTangent<D>>&, const std::vector<long long>&, long long);
+COSPH_INSTANTIATE_STATIC_TANGENT(2)
+COSPH_INSTANTIATE_STATIC_TANGENT(3)
+
+}  // namespace cosph
