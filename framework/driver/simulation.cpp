@@ -515,9 +515,8 @@ RunSummary Simulation::run() {
   summary.output_directory = I.directory;
   for (const TimedModule* m : tree_.modules) {
     const ModuleInfo info = m->info();
-    summary.modules.push_back(
-        {info.name, info.type, m->particle_count(), info.active_features, m->advance_seconds(),
-         info.statistics});
+    summary.modules.push_back({info.name, info.type, m->particle_count(), info.active_features,
+                               m->advance_seconds(), info.statistics});
     summary.particles += m->particle_count();
   }
   for (std::size_t c = 0; c < tree_.couplers.size(); ++c) {

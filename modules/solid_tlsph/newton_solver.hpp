@@ -22,9 +22,9 @@ struct NewtonSettings {
 
 struct NewtonOutcome {
   bool converged = false;
-  int iterations = 0;             // tangent solves
-  int residual_evaluations = 0;   // line-search trials included
-  double relative_residual = 0.0; // |R| / scale at the returned x
+  int iterations = 0;              // tangent solves
+  int residual_evaluations = 0;    // line-search trials included
+  double relative_residual = 0.0;  // |R| / scale at the returned x
 };
 
 class NewtonSolver {

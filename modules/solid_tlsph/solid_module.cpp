@@ -833,8 +833,8 @@ class SolidModule final : public StaticBodyModule<D> {
       }));
     };
     const double internal = free_norm([&](std::size_t i, int a) { return internal_force_[i][a]; });
-    const double external = free_norm(
-        [&](std::size_t i, int a) { return force[i][a] - internal_force_[i][a]; });
+    const double external =
+        free_norm([&](std::size_t i, int a) { return force[i][a] - internal_force_[i][a]; });
     return std::max(internal, external);
   }
 
@@ -891,12 +891,12 @@ class SolidModule final : public StaticBodyModule<D> {
       return;
     }
     if (depth == kMaxBisections)
-      throw RuntimeError("module '" + name_ + "': the steady state at t = " + short_number(t1) +
-                         " did not converge (relative residual " +
-                         short_number(outcome.relative_residual) + " after " +
-                         std::to_string(outcome.iterations) + " Newton iterations, load increment " +
-                         short_number(t1 - t0) + " after " + std::to_string(kMaxBisections) +
-                         " bisections); the load may exceed what the body can carry");
+      throw RuntimeError(
+          "module '" + name_ + "': the steady state at t = " + short_number(t1) +
+          " did not converge (relative residual " + short_number(outcome.relative_residual) +
+          " after " + std::to_string(outcome.iterations) + " Newton iterations, load increment " +
+          short_number(t1 - t0) + " after " + std::to_string(kMaxBisections) +
+          " bisections); the load may exceed what the body can carry");
     ++steady_bisections_;
     u = start;
     solve_increment(t0, 0.5 * (t0 + t1), u, depth + 1);
@@ -926,10 +926,10 @@ class SolidModule final : public StaticBodyModule<D> {
   // Steady state only.
   std::optional<StaticEquilibrium<D>> equilibrium_;
   typename StaticEquilibrium<D>::Body static_body_;
-  std::vector<char> prescribed_;             // per component: held by a constraint
+  std::vector<char> prescribed_;  // per component: held by a constraint
   std::vector<Vec<D>> zero_velocity_, internal_force_;
-  std::vector<Index> loaded_particles_;      // particles under a follower pressure
-  std::vector<long long> loaded_slot_;       // their index in loaded_particles_ (-1: none)
+  std::vector<Index> loaded_particles_;  // particles under a follower pressure
+  std::vector<long long> loaded_slot_;   // their index in loaded_particles_ (-1: none)
   long long steady_increments_ = 0, steady_bisections_ = 0, newton_iterations_ = 0;
   double steady_residual_ = 0.0;
   double stiffness_eigenvalue_ = 0.0;

@@ -49,8 +49,7 @@ class StaticEquilibrium {
     // The net force on every particle at displacements u (zero on prescribed components) and
     // the scale of the forces in balance (|f_internal| and |f_external| over the free
     // components); keeps F_i of u for the tangent callback.
-    std::function<double(double t, const std::vector<Vec<D>>& u, std::vector<Vec<D>>& force)>
-        force;
+    std::function<double(double t, const std::vector<Vec<D>>& u, std::vector<Vec<D>>& force)> force;
     // C_i = dP/dF for every particle and L_i = df_i/dF_i for the particles with a force of their
     // own (the follower pressure), at the F of the last force call.
     std::function<void(double t, std::vector<MaterialTangent<D>>& C, std::vector<Index>& loaded,

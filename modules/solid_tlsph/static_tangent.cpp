@@ -18,10 +18,13 @@ Vec<D> coefficient(const ReferencePairs<D>& pairs, std::size_t i, std::size_t sl
 
 template <int D>
 Index node(const ReferencePairs<D>& pairs, std::size_t i, std::size_t slot) {
-  return slot == 0 ? static_cast<Index>(i) : pairs.neighbours.index[pairs.neighbours.offset[i] + slot - 1];
+  return slot == 0 ? static_cast<Index>(i)
+                   : pairs.neighbours.index[pairs.neighbours.offset[i] + slot - 1];
 }
 
-std::size_t slots(const NeighbourList& nl, std::size_t i) { return nl.offset[i + 1] - nl.offset[i] + 1; }
+std::size_t slots(const NeighbourList& nl, std::size_t i) {
+  return nl.offset[i + 1] - nl.offset[i] + 1;
+}
 
 // Position of column k in row j of the pattern (present by construction).
 std::size_t find_column(const TangentPattern& pattern, std::size_t j, Index k) {
@@ -174,11 +177,11 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
   return matrix;
 }
 
-#define COSPH_INSTANTIATE_STATIC_TANGENT(D)                                                      \
-  template TangentPattern build_tangent_pattern<D>(const ReferencePairs<D>&);                    \
-  template Eigen::SparseMatrix<double> assemble_tangent<D>(                                      \
-      const ReferencePairs<D>&, const TangentPattern&, const std::vector<double>&,               \
-      const std::vector<MaterialTangent<D>>&, const std::vector<Index>&,                         \
+#define COSPH_INSTANTIATE_STATIC_TANGENT(D)                                        \
+  template TangentPattern build_tangent_pattern<D>(const ReferencePairs<D>&);      \
+  template Eigen::SparseMatrix<double> assemble_tangent<D>(                        \
+      const ReferencePairs<D>&, const TangentPattern&, const std::vector<double>&, \
+      const std::vector<MaterialTangent<D>>&, const std::vector<Index>&,           \
       const std::vector<ForceTangent<D>>&, const std::vector<long long>&, long long);
 COSPH_INSTANTIATE_STATIC_TANGENT(2)
 COSPH_INSTANTIATE_STATIC_TANGENT(3)

@@ -52,7 +52,6 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
                                              const std::vector<MaterialTangent<D>>& C,
                                              const std::vector<Index>& force_tangent_particles,
                                              const std::vector<ForceTangent<D>>& force_tangents,
-                                             const std::vector<long long>& dof,
-                                             long long unknowns);
+                                             const std::vector<long long>& dof, long long unknowns);
 
 }  // namespace cosph

@@ -21,10 +21,10 @@ template <int D>
 struct Problem {
   test::TlsphBody<D> body;
   MaterialModel<D> material;
-  std::vector<Index> loaded;       // particles under the follower pressure
-  std::vector<Vec<D>> area;        // their reference area vectors N dA
+  std::vector<Index> loaded;  // particles under the follower pressure
+  std::vector<Vec<D>> area;   // their reference area vectors N dA
   double pressure = 0.0;
-  std::vector<long long> dof;      // -1: prescribed
+  std::vector<long long> dof;  // -1: prescribed
   long long unknowns = 0;
 
   // Net force on every particle: V_i (stress divergence) minus p J F^-T N dA.
@@ -63,14 +63,19 @@ Problem<D> make_problem(GradientCorrection correction, unsigned seed) {
   std::vector<double> V(X.size());
   for (double& v : V) v = std::pow(kTestSpacing, D) * volume_jitter(rng);
   Problem<D> p{test::make_tlsph_body<D>(X, V, correction, false),
-               {neo_hookean(), "material"}, {}, {}, 0.0, {}, 0};
+               {neo_hookean(), "material"},
+               {},
+               {},
+               0.0,
+               {},
+               0};
   const std::size_t count = p.body.X.size();
   p.dof.assign(count * D, 0);
   for (std::size_t i = 0; i < count; ++i) {
     const double x = p.body.X[i][0], y = p.body.X[i][1];
     for (int a = 0; a < D; ++a) {
-      const bool clamped = x < kTestSpacing;                         // the first layer
-      const bool fixed = a == 1 && x > 4 * kTestSpacing;             // a roller at the far end
+      const bool clamped = x < kTestSpacing;              // the first layer
+      const bool fixed = a == 1 && x > 4 * kTestSpacing;  // a roller at the far end
       p.dof[i * D + a] = clamped || fixed ? -1 : p.unknowns++;
     }
     if (y > 3 * kTestSpacing) {  // the top layer: a pressure on a face of normal +y
@@ -110,8 +115,8 @@ void check_tangent(GradientCorrection correction, unsigned seed) {
         },
         F[p.loaded[k]]);
   const TangentPattern pattern = build_tangent_pattern<D>(p.body.pairs);
-  const Eigen::MatrixXd K = Eigen::MatrixXd(assemble_tangent<D>(
-      p.body.pairs, pattern, p.body.V, C, p.loaded, L, p.dof, p.unknowns));
+  const Eigen::MatrixXd K = Eigen::MatrixXd(
+      assemble_tangent<D>(p.body.pairs, pattern, p.body.V, C, p.loaded, L, p.dof, p.unknowns));
 
   // J = -dR/du column by column, by central differences of the force.
   Eigen::MatrixXd J(p.unknowns, p.unknowns);
@@ -130,8 +135,8 @@ void check_tangent(GradientCorrection correction, unsigned seed) {
   const double error = (K - symmetric).norm() / symmetric.norm();
   const double asymmetry = (J - J.transpose()).norm() / J.norm();
   std::cout << D << "D " << (correction == GradientCorrection::linear ? "linear" : "quadratic")
-            << ": |K - sym(J_fd)| / |J| = " << error << ", follower asymmetry " << asymmetry
-            << ", " << p.unknowns << " unknowns\n";
+            << ": |K - sym(J_fd)| / |J| = " << error << ", follower asymmetry " << asymmetry << ", "
+            << p.unknowns << " unknowns\n";
   EXPECT_LT(error, 1e-8);  // measured 0.98e-9 to 6.1e-9 (the differences' own error)
   // The pressure makes J unsymmetric; a test whose J were symmetric could not see the
   // symmetrisation at all.
