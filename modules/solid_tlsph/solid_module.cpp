@@ -68,7 +68,8 @@ class SolidModule final : public StaticBodyModule<D> {
       f.push_back("quadratic gradient correction (" + std::to_string(pairs_.quadratic_particles()) +
                   " of " + std::to_string(X_.size()) + " particles)");
     if (steady())
-      f.push_back("steady state: Newton, " + std::to_string(spec_.steady_state().load_steps()) +
+      f.push_back("steady state: quasi-Newton, " +
+                  std::to_string(spec_.steady_state().load_steps()) +
                   " load step(s) over the ramp, relative tolerance " +
                   short_number(spec_.steady_state().tolerance()));
     else
@@ -87,6 +88,8 @@ class SolidModule final : public StaticBodyModule<D> {
       info.statistics["load_increments"] = double(steady_increments_);
       info.statistics["increment_bisections"] = double(steady_bisections_);
       info.statistics["newton_iterations"] = double(newton_iterations_);
+      info.statistics["tangent_factorisations"] = double(factorisations_);
+      info.statistics["shifted_factorisations"] = double(shifted_factorisations_);
       info.statistics["relative_residual"] = steady_residual_;
       info.statistics["factorisation_seconds"] =
           equilibrium_ ? equilibrium_->factorisation_seconds() : 0.0;
@@ -318,6 +321,8 @@ class SolidModule final : public StaticBodyModule<D> {
       state.integers["load_increments"] = steady_increments_;
       state.integers["increment_bisections"] = steady_bisections_;
       state.integers["newton_iterations"] = newton_iterations_;
+      state.integers["tangent_factorisations"] = factorisations_;
+      state.integers["shifted_factorisations"] = shifted_factorisations_;
       state.scalars["relative_residual"] = steady_residual_;
     }
   }
@@ -344,6 +349,8 @@ class SolidModule final : public StaticBodyModule<D> {
       steady_increments_ = read.integer("load_increments");
       steady_bisections_ = read.integer("increment_bisections");
       newton_iterations_ = read.integer("newton_iterations");
+      factorisations_ = read.integer("tangent_factorisations");
+      shifted_factorisations_ = read.integer("shifted_factorisations");
       steady_residual_ = read.scalar("relative_residual");
     }
     const auto& u = particles_.vector("displacement");
@@ -885,6 +892,8 @@ class SolidModule final : public StaticBodyModule<D> {
                             spec_.steady_state().max_iterations()};
     const NewtonOutcome outcome = equilibrium_->solve(t1, u, static_body_, settings);
     newton_iterations_ += outcome.iterations;
+    factorisations_ += outcome.factorisations;
+    shifted_factorisations_ += outcome.shifted_factorisations;
     steady_residual_ = outcome.relative_residual;
     if (outcome.converged) {
       ++steady_increments_;
@@ -930,7 +939,8 @@ class SolidModule final : public StaticBodyModule<D> {
   std::vector<Vec<D>> zero_velocity_, internal_force_;
   std::vector<Index> loaded_particles_;  // particles under a follower pressure
   std::vector<long long> loaded_slot_;   // their index in loaded_particles_ (-1: none)
-  long long steady_increments_ = 0, steady_bisections_ = 0, newton_iterations_ = 0;
+  long long steady_increments_ = 0, steady_bisections_ = 0, newton_iterations_ = 0,
+            factorisations_ = 0, shifted_factorisations_ = 0;
   double steady_residual_ = 0.0;
   double stiffness_eigenvalue_ = 0.0;
 };

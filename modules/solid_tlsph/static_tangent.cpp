@@ -132,21 +132,29 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
     }
   });
 
-  // The symmetric part on the free unknowns, in compressed column storage. Column dof(j, a) holds
-  // rows dof(k, c) of the blocks (j, k), k ascending: K_s(k, j)[c][a] = K_s(j, k)[a][c].
+  // The lower triangle of the symmetric part on the free unknowns, in compressed column storage
+  // (what the Cholesky factorisation reads). Column dof(j, a) holds rows dof(k, c) >= dof(j, a)
+  // of the blocks (j, k), k ascending: K_s(k, j)[c][a] = K_s(j, k)[a][c].
+  auto for_each_lower_entry = [&](std::size_t j, int a, auto&& visit) {
+    const long long col = dof[j * D + a];
+    for (std::size_t p = pattern.offset[j]; p < pattern.offset[j + 1]; ++p) {
+      const Index k = pattern.column[p];
+      for (int c = 0; c < D; ++c) {
+        const long long row = dof[k * D + c];
+        if (row >= col) visit(p, k, c, row);
+      }
+    }
+  };
   std::vector<long long> column_start(static_cast<std::size_t>(unknowns) + 1, 0);
-  std::vector<long long> row_count(n, 0);
   parallel_for_each_index(n, [&](std::size_t j) {
-    long long count = 0;
-    for (std::size_t p = pattern.offset[j]; p < pattern.offset[j + 1]; ++p)
-      for (int c = 0; c < D; ++c) count += dof[pattern.column[p] * D + c] >= 0 ? 1 : 0;
-    row_count[j] = count;
-  });
-  for (std::size_t j = 0; j < n; ++j)
     for (int a = 0; a < D; ++a) {
       const long long col = dof[j * D + a];
-      if (col >= 0) column_start[static_cast<std::size_t>(col) + 1] = row_count[j];
+      if (col < 0) continue;
+      long long count = 0;
+      for_each_lower_entry(j, a, [&](std::size_t, Index, int, long long) { ++count; });
+      column_start[static_cast<std::size_t>(col) + 1] = count;
     }
+  });
   for (long long c = 0; c < unknowns; ++c)
     column_start[static_cast<std::size_t>(c) + 1] += column_start[static_cast<std::size_t>(c)];
   Eigen::SparseMatrix<double> matrix(unknowns, unknowns);
@@ -160,18 +168,12 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
       const long long col = dof[j * D + a];
       if (col < 0) continue;
       long long at = column_start[static_cast<std::size_t>(col)];
-      for (std::size_t p = pattern.offset[j]; p < pattern.offset[j + 1]; ++p) {
-        const Index k = pattern.column[p];
-        const Block& forward = K[p];
+      for_each_lower_entry(j, a, [&](std::size_t p, Index k, int c, long long row) {
         const Block& backward = K[find_column(pattern, k, static_cast<Index>(j))];
-        for (int c = 0; c < D; ++c) {
-          const long long row = dof[k * D + c];
-          if (row < 0) continue;
-          inner[at] = static_cast<int>(row);
-          value[at] = 0.5 * (forward(a, c) + backward(c, a));
-          ++at;
-        }
-      }
+        inner[at] = static_cast<int>(row);
+        value[at] = 0.5 * (K[p](a, c) + backward(c, a));
+        ++at;
+      });
     }
   });
   return matrix;

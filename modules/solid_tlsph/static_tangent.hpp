@@ -40,11 +40,12 @@ TangentPattern build_tangent_pattern(const ReferencePairs<D>& pairs);
 // The stiffness restricted to the free degrees of freedom: dof[i * D + a] is the unknown's index of
 // component a of particle i, or -1 where the component is prescribed. C holds C_i for every
 // particle; force_tangent_particles / force_tangents the L_i of particles with a force of their
-// own (may be empty). Returns the symmetric part (K + K^T) / 2, the matrix a Cholesky-type solver
-// takes: the follower pressure's own stiffness is not symmetric, and Newton's iteration with the
-// symmetric part converges linearly at the rate of the pressure's share of the stiffness of the
-// deformation being solved for (small against the material's, but not against a slender body's
-// bending: 0.15-0.2 per iteration near the solution of Land's beam, measured).
+// own (may be empty). Returns the lower triangle of the symmetric part (K + K^T) / 2, the matrix
+// a Cholesky-type solver takes (selfadjointView<Lower> gives the whole): the follower pressure's
+// own stiffness is not symmetric, and Newton's iteration with the symmetric part converges linearly
+// at the rate of the pressure's share of the stiffness of the deformation being solved for (small
+// against the material's, but not against a slender body's bending: 0.15-0.2 per iteration near the
+// solution of Land's beam, measured).
 template <int D>
 Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
                                              const TangentPattern& pattern,

@@ -115,8 +115,12 @@ void check_tangent(GradientCorrection correction, unsigned seed) {
         },
         F[p.loaded[k]]);
   const TangentPattern pattern = build_tangent_pattern<D>(p.body.pairs);
-  const Eigen::MatrixXd K = Eigen::MatrixXd(
-      assemble_tangent<D>(p.body.pairs, pattern, p.body.V, C, p.loaded, L, p.dof, p.unknowns));
+  const Eigen::SparseMatrix<double> lower =
+      assemble_tangent<D>(p.body.pairs, pattern, p.body.V, C, p.loaded, L, p.dof, p.unknowns);
+  const Eigen::MatrixXd upper_part = Eigen::MatrixXd(lower).triangularView<Eigen::StrictlyUpper>();
+  EXPECT_EQ(upper_part.norm(), 0.0);  // the lower triangle only
+  const Eigen::SparseMatrix<double> whole = lower.selfadjointView<Eigen::Lower>();
+  const Eigen::MatrixXd K = Eigen::MatrixXd(whole);
 
   // J = -dR/du column by column, by central differences of the force.
   Eigen::MatrixXd J(p.unknowns, p.unknowns);
