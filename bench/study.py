@@ -123,6 +123,17 @@ class Reference:
     ordinate: Optional[np.ndarray] = None
     along: str = "time"
     value: Optional[float] = None
+    band: Optional[tuple] = None  # (low, high, label): where a set of reference solvers spread
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Another method's final values against its particle count (a paper's convergence table),
+    drawn beside cosph's points; it is not what errors are measured against."""
+    label: str
+    source: str
+    particles: np.ndarray
+    values: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -141,6 +152,7 @@ class Study:
     threshold: Optional[float]
     repeat: int
     order: Optional[int]
+    comparisons: tuple = ()
 
     def points(self) -> list:
         """The cartesian product of the axes, then the explicit points."""
@@ -238,7 +250,7 @@ def load_study(path: Path) -> Study:
 def _parse_study(path: Path, root: Any) -> Study:
     _check_keys(root, "study", ("title", "description", "scene", "sweep", "quantity",
                                 "reference", "norm"),
-                ("name", "overrides", "threshold", "repeat", "order"))
+                ("name", "overrides", "threshold", "repeat", "order", "comparisons"))
     scene = (path.parent / _string(root["scene"], "scene")).resolve()
     if not scene.is_file():
         raise StudyError(f"scene: no such file: {scene}")
@@ -264,12 +276,36 @@ def _parse_study(path: Path, root: Any) -> Study:
     order = root.get("order")
     if order is not None and (not isinstance(order, int) or isinstance(order, bool)):
         raise StudyError(f"order: expected an integer, got {order!r}")
+    comparisons = _parse_comparisons(root.get("comparisons"), path.parent, quantity)
     return Study(path=path.resolve(), name=_string(root.get("name", path.stem), "name"),
                  title=_string(root["title"], "title"),
                  description=_string(root["description"], "description"), scene=scene,
                  overrides=_overrides(root.get("overrides"), "overrides"), axes=axes,
                  explicit_points=explicit, quantity=quantity, reference=reference, norm=norm,
-                 threshold=threshold, repeat=repeat, order=order)
+                 threshold=threshold, repeat=repeat, order=order, comparisons=comparisons)
+
+
+def _parse_comparisons(node: Any, base: Path, quantity: Quantity) -> tuple:
+    """comparisons: [{label, source, csv, columns: [particles column, value column]}, ...]"""
+    if node is None:
+        return ()
+    if quantity.kind != "final":
+        raise StudyError("comparisons: only for a final value (drawn against particle count)")
+    if not isinstance(node, list):
+        raise StudyError("comparisons: expected a list")
+    comparisons = []
+    for i, item in enumerate(node):
+        where = f"comparisons[{i}]"
+        _check_keys(item, where, ("label", "source", "csv", "columns"))
+        columns = item["columns"]
+        if not isinstance(columns, list) or len(columns) != 2:
+            raise StudyError(f"{where}.columns: expected [particles column, value column]")
+        particles, values = read_reference_csv(
+            (base / _string(item["csv"], f"{where}.csv")).resolve(), columns)
+        comparisons.append(Comparison(_string(item["label"], f"{where}.label"),
+                                      _string(item["source"], f"{where}.source"),
+                                      particles, values))
+    return tuple(comparisons)
 
 
 def _parse_sweep(node: Any) -> tuple:
@@ -436,8 +472,9 @@ def _parse_reference(node: Any, base: Path, quantity: Quantity, norm: str) -> Re
         code = compile_expression(text, "reference.expression", known)
         return Reference(kind, source, expression=text, definitions=definitions, code=code)
     if kind == "value":
-        _check_keys(node, "reference", ("source", "value"))
-        return Reference(kind, source, value=_number(node["value"], "reference.value"))
+        _check_keys(node, "reference", ("source", "value"), ("band",))
+        return Reference(kind, source, value=_number(node["value"], "reference.value"),
+                         band=_parse_band(node.get("band")))
     _check_keys(node, "reference", ("source", "csv", "columns"), ("along",))
     along = node.get("along", "time")
     if along not in CSV_ALONG:
@@ -451,6 +488,17 @@ def _parse_reference(node: Any, base: Path, quantity: Quantity, norm: str) -> Re
     abscissa, ordinate = read_reference_csv(csv_file, columns)
     return Reference(kind, source, csv_file=csv_file, abscissa=abscissa, ordinate=ordinate,
                      along=along)
+
+
+def _parse_band(node: Any) -> Optional[tuple]:
+    """reference.band: {low, high, label}, the spread of the solvers the value comes from."""
+    if node is None:
+        return None
+    _check_keys(node, "reference.band", ("low", "high", "label"))
+    low, high = _number(node["low"], "reference.band.low"), _number(node["high"], "reference.band.high")
+    if not low < high:
+        raise StudyError(f"reference.band: low ({low}) must be below high ({high})")
+    return (low, high, _string(node["label"], "reference.band.label"))
 
 
 def _compile_definitions(node: Any) -> tuple:
@@ -1176,6 +1224,11 @@ def _plot_final_values(ax, study: Study, results: list) -> None:
                     label=f"cosph, {group.name}" if group.name else "cosph")
             reference = ok[0].reference_values[-1]
     ax.axhline(reference, color="k", lw=1.4, label="reference")
+    if study.reference.band is not None:
+        low, high, label = study.reference.band
+        ax.axhspan(low, high, color="0.85", zorder=0, label=label)
+    for comparison in study.comparisons:
+        ax.plot(comparison.particles, comparison.values, "s--", mfc="none", label=comparison.label)
     ax.set_xscale("log")
     ax.set_xlabel("particles")
     ax.set_ylabel(ok[0].sample.field_name)

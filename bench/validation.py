@@ -145,7 +145,15 @@ def reference_lines(study: studies.Study, doc_dir: Path) -> list:
                      f"along {reference.along}.")
     else:
         lines.append(f"Reference (a number): {reference.value:.10g}.")
+        if reference.band is not None:
+            low, high, label = reference.band
+            lines.append(f"Band in the plot: {label}, {low:.10g} to {high:.10g}.")
     lines += ["", f"Source: {reference.source}."]
+    for comparison in study.comparisons:
+        values = ", ".join(f"{v:.6g} at {p:.0f}" for p, v in
+                           zip(comparison.particles, comparison.values))
+        lines += ["", f"Beside it in the plot: {comparison.label} ({values} particles). "
+                  f"Source: {comparison.source}."]
     return lines
 
 

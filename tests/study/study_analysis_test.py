@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Unit tests of bench/study.py's time-series analysis: the dominant oscillation of a noisy
-signal, the smoothing and window of a quantity, and the run key of the run cache."""
+signal, the smoothing and window of a quantity, the run key of the run cache, and a study's
+comparison tables and reference band."""
 import sys
 import tempfile
 import unittest
@@ -74,6 +75,48 @@ class RunKey(unittest.TestCase):
             key = study.run_key(exe, scene, {}, 1)
             table.write_text("x,y,f\n0,0,2\n")
             self.assertNotEqual(key, study.run_key(exe, scene, {}, 1))
+
+
+class ComparisonsAndBand(unittest.TestCase):
+    """A final-value study may draw another method's table beside its points and the spread of
+    the reference solvers; anything malformed is refused with its key."""
+
+    SCENE = ("dimension: 2\nend_time: 1\nprobes:\n  - name: tip\n"
+             "    points: {at: [{coordinates: [0, 0]}], fields: [z]}\n")
+    STUDY = """title: t
+description: d
+scene: scene.yaml
+sweep: {{axes: [{{key: a, values: [1, 2]}}]}}
+quantity: {{probe: tip, kind: {kind}, column: z}}
+reference: {{value: 4.17, source: s{band}}}
+comparisons: [{{label: seed, source: table 1, csv: table.csv, columns: [particles, z]}}]
+norm: {norm}
+"""
+
+    def load(self, kind="final", norm="relative_at_point", band=""):
+        with tempfile.TemporaryDirectory() as directory:
+            root = Path(directory)
+            (root / "scene.yaml").write_text(self.SCENE)
+            (root / "table.csv").write_text("# a comment\nparticles,z\n4544,4.217\n1025,4.707\n")
+            path = root / "study.yaml"
+            path.write_text(self.STUDY.format(kind=kind, norm=norm, band=band))
+            return study.load_study(path)
+
+    def test_table_is_read_sorted_by_particle_count_and_band_kept(self):
+        loaded = self.load(band=", band: {low: 4.0, high: 4.2, label: FEM}")
+        (comparison,) = loaded.comparisons
+        self.assertEqual(comparison.label, "seed")
+        self.assertEqual(list(comparison.particles), [1025.0, 4544.0])
+        self.assertEqual(list(comparison.values), [4.707, 4.217])
+        self.assertEqual(loaded.reference.band, (4.0, 4.2, "FEM"))
+
+    def test_refuses_a_table_beside_a_time_series_and_an_empty_band(self):
+        with self.assertRaisesRegex(study.StudyError, "comparisons: only for a final value"):
+            self.load(kind="time_series", norm="l2_time")
+        with self.assertRaisesRegex(study.StudyError, "reference.band: low"):
+            self.load(band=", band: {low: 4.2, high: 4.0, label: FEM}")
+        with self.assertRaisesRegex(study.StudyError, "reference.band.*colour"):
+            self.load(band=", band: {low: 4.0, high: 4.2, label: FEM, colour: red}")
 
 
 if __name__ == "__main__":
