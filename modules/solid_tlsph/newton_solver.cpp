@@ -144,11 +144,8 @@ bool NewtonSolver::refresh_tangent(const Eigen::VectorXd& x, const Tangent& tang
 }
 
 NewtonOutcome NewtonSolver::solve(Eigen::VectorXd& x, const Residual& residual,
-                                  const Tangent& tangent, const NewtonSettings& settings_in) {
+                                  const Tangent& tangent, const NewtonSettings& settings) {
   NewtonOutcome outcome;
-  NewtonSettings settings = settings_in;
-  if (const char* e = std::getenv("COSPH_RATIO")) settings.refresh_ratio = std::atof(e);
-  if (const char* e = std::getenv("COSPH_HIST")) settings.history = std::atoi(e);
   Iterate at;
   at.x = x;
   at.r.resize(x.size());

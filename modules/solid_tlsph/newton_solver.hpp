@@ -22,11 +22,12 @@ struct NewtonSettings {
   int max_iterations = 200;
   // A new tangent is assembled and factorised when an iteration multiplies |R| by more than this
   // ratio (the lagged one has stopped describing the body), or after `history` quasi-Newton
-  // iterations on one factorisation. Measured on Land's beam (2 load steps, 2 threads): a
-  // factorisation costs 1.1-1.6 s at 4,544 particles against 0.02-0.03 s per iteration, and
-  // refreshing only on a full history of 60 took 151 iterations, 4 factorisations, 12.6-14.4 s
-  // (1,025 particles: 153, 4, 1.5-1.8 s); a ratio of 10 or 100 refreshed 6 times (14.7-16.2 s),
-  // a history of 100 took 226 iterations (14.4 s), exact Newton 38 iterations and 77.6 s.
+  // iterations on one factorisation. Measured on Land's beam (2 load steps, 2 threads, before
+  // BLAS was held to one thread): a factorisation costs 1.1-1.6 s at 4,544 particles against
+  // 0.02-0.03 s per iteration, and refreshing only on a full history of 60 took 151 iterations, 4
+  // factorisations, 12.6-14.4 s (1,025 particles: 153, 4, 1.5-1.8 s); a ratio of 10 or 100
+  // refreshed 6 times (14.7-16.2 s), a history of 100 took 226 iterations (14.4 s), exact Newton 38
+  // iterations and 77.6 s.
   double refresh_ratio = 1000.0;
   int history = 60;
 };
@@ -68,7 +69,7 @@ class NewtonSolver {
   };
   struct HistoryPair {
     Eigen::VectorXd s, y;
-    double rho;
+    double rho = 0.0;
   };
 
   Eigen::VectorXd direction(const Eigen::VectorXd& r) const;
