@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "geometry/lattice.hpp"
 #include "geometry/point_cloud_csv.hpp"
+#include "geometry/shell_nodes.hpp"
 #include "neighbour/cell_linked_list.hpp"
 
 namespace cosph {
@@ -69,6 +70,36 @@ ShapePtr<D> make_shape(const proto::Shape& spec, const std::string& path) {
                     "polygon, union, difference");
 }
 
+// The nodes of a shape's own structured grid (placement: conforming); only the truncated
+// ellipsoidal shell has one.
+template <int D>
+ParticleCloud<D> conforming_body(const proto::BodySpec& spec, const std::string& key_path) {
+  if constexpr (D == 3) {
+    if (spec.shape().kind_case() == proto::Shape::kTruncatedEllipsoidalShell) {
+      if (spec.lattice_anchor_size() > 0)
+        throw ConfigError(key_path + ".lattice_anchor",
+                          "a conforming placement follows the shape, not a lattice anchor");
+      if (spec.perturbation() > 0.0)
+        throw ConfigError(key_path + ".perturbation",
+                          "a conforming placement's faces are exact; perturbation would move "
+                          "its face nodes off them");
+      const auto& s = spec.shape().truncated_ellipsoidal_shell();
+      try {
+        return conforming_shell_nodes(
+            TruncatedEllipsoidalShell(s.inner_short_radius(), s.inner_long_radius(),
+                                      s.outer_short_radius(), s.outer_long_radius(),
+                                      s.truncation()),
+            spec.spacing());
+      } catch (const std::invalid_argument& e) {
+        throw ConfigError(key_path, e.what());
+      }
+    }
+  }
+  throw ConfigError(key_path + ".placement",
+                    "placement conforming needs a truncated_ellipsoidal_shell shape (a box's "
+                    "conforming grid is placement: vertex)");
+}
+
 }  // namespace
 
 template <int D>
@@ -99,6 +130,8 @@ ParticleCloud<D> build_body(const proto::BodySpec& spec, const std::string& key_
     }
   }
   auto shape = build_shape<D>(spec.shape(), key_path + ".shape");
+  if (lattice_placement(spec) == LatticePlacement::conforming)
+    return conforming_body<D>(spec, key_path);
   ParticleCloud<D> cloud;
   try {
     cloud = lattice_fill<D>(*shape, spec.spacing(), to_vec<D>(spec.lattice_anchor()),
@@ -138,7 +171,9 @@ Domain<D> build_domain(const proto::Scene& scene) {
 
 LatticePlacement lattice_placement(const proto::BodySpec& spec) {
   if (spec.has_points_csv()) return LatticePlacement::cell;
-  return spec.placement() == "vertex" ? LatticePlacement::vertex : LatticePlacement::cell;
+  if (spec.placement() == "vertex") return LatticePlacement::vertex;
+  if (spec.placement() == "conforming") return LatticePlacement::conforming;
+  return LatticePlacement::cell;
 }
 
 Kernel build_kernel(const proto::BodySpec& body, int dimension) {
@@ -173,7 +208,8 @@ void check_body_cloud(const proto::Scene& scene, const ParticleCloud<D>& cloud,
 template <int D>
 void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
                        const std::string& key_path, const std::string& scene_directory,
-                       const Kernel& kernel, ParticleSet<D>& particles) {
+                       const Kernel& kernel, ParticleSet<D>& particles,
+                       std::vector<BoundaryFace<D>>* faces) {
   const ParticleCloud<D> cloud = build_body<D>(spec, key_path, scene_directory);
   check_body_cloud<D>(scene, cloud, key_path);
   const Domain<D> domain = build_domain<D>(scene);
@@ -186,6 +222,12 @@ void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
         domain.any_periodic() ? domain.wrap(cloud.positions[order[k]]) : cloud.positions[order[k]];
     V[k] = cloud.volumes[order[k]];
   }
+  if (!faces) return;
+  std::vector<std::size_t> position_of(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) position_of[order[k]] = k;
+  *faces = cloud.faces;
+  for (auto& face : *faces)
+    for (auto& i : face.particles) i = position_of[i];
 }
 
 #define COSPH_INSTANTIATE(D)                                                                \
@@ -198,7 +240,7 @@ void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
                                     const std::string&);                                    \
   template void build_static_body<D>(const proto::Scene&, const proto::BodySpec&,           \
                                      const std::string&, const std::string&, const Kernel&, \
-                                     ParticleSet<D>&);
+                                     ParticleSet<D>&, std::vector<BoundaryFace<D>>*);
 COSPH_INSTANTIATE(2)
 COSPH_INSTANTIATE(3)
 

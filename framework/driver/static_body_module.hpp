@@ -46,7 +46,8 @@ class StaticBodyModule : public Module {
  protected:
   // Builds the body's particles ("position", "volume"), sorted by cell once.
   void build_body() {
-    build_static_body<D>(scene_, body_spec_, key_ + ".body", scene_directory_, kernel_, particles_);
+    build_static_body<D>(scene_, body_spec_, key_ + ".body", scene_directory_, kernel_, particles_,
+                         &faces_);
   }
 
   // Parses a scene expression; its errors become ConfigErrors at `key`.
@@ -102,6 +103,7 @@ class StaticBodyModule : public Module {
   std::string scene_directory_;
   proto::BodySpec body_spec_;
   ParticleSet<D> particles_;
+  std::vector<BoundaryFace<D>> faces_;  // the placement's exact faces, if it knows them
   Kernel kernel_;
   Domain<D> domain_;
   double time_ = 0.0;

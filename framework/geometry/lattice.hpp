@@ -25,7 +25,9 @@ inline constexpr double kMaxLatticeSites = 2e8;
 //   cell (exact for faces through a vertex or halfway between vertices; across a curved face the
 //   dual cells of the nodes just outside are lost, a first-order deficit); a site within 1e-9
 //   spacings of the shape counts as on it, so that rounding cannot drop a face's layer.
-enum class LatticePlacement { cell, vertex };
+// - conforming: not a lattice; a shape's own structured grid (shell_nodes.hpp), built by the
+//   scene's body builder, never by lattice_fill.
+enum class LatticePlacement { cell, vertex, conforming };
 
 // The sites of the placement that the shape contains, with their volumes. Order: axis 0 (x)
 // fastest, then y, then z, i.e. increasing (z, y, x) lexicographically; the result does not depend

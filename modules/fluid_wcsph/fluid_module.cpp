@@ -92,11 +92,11 @@ class FluidModule final : public Module {
   void initialize() override {
     // The fluid's particles move off any lattice at once; what they need is one mass each, so that
     // the density summation and its reinitialisation read rho0 in the bulk.
-    if (lattice_placement(spec_.body()) == LatticePlacement::vertex)
+    if (lattice_placement(spec_.body()) != LatticePlacement::cell)
       throw ConfigError(
           key_ + ".body.placement",
-          "the fluid needs equal particle volumes (placement: cell); vertex placement "
-          "gives its face, edge and corner particles fractions of a cell");
+          "the fluid needs equal particle volumes (placement: cell); vertex and conforming "
+          "placements give their face, edge and corner particles fractions of a cell");
     const ParticleCloud<D> cloud = build_body<D>(spec_.body(), key_ + ".body", scene_directory_);
     check_body_cloud<D>(scene_, cloud, key_ + ".body");
     const std::size_t n = cloud.positions.size();

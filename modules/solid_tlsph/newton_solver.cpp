@@ -15,14 +15,18 @@ constexpr int kLineSearchTrials = 4;
 
 // OpenBLAS, under CHOLMOD's dense kernels, splits each product over its own threads (one per core
 // by default, whatever --threads says), and the split changes the rounding: Land's beam tip moved
-// by 8e-12 relative between one and two BLAS threads. One BLAS thread keeps the solution
-// independent of the machine and of the thread count, at 10-20% of the solve's time (measured on
-// 4,544 particles). Looked up at run time: the BLAS behind CHOLMOD may not be OpenBLAS.
-void use_one_blas_thread() {
+// by 8e-12 relative between one and two BLAS threads. A fixed count keeps the solution
+// independent of the machine and of --threads; two halve the factorisation on a 2-core machine
+// (OpenBLAS's partition of a product over a fixed number of threads is itself deterministic: no
+// shared sums). The factorisation runs alone (the particle loops wait for it), so these threads do
+// not compete with the pool's. Looked up at run time: the BLAS behind CHOLMOD may not be OpenBLAS.
+constexpr int kBlasThreads = 2;
+
+void fix_blas_threads() {
   static const bool done = [] {
     using SetThreads = void (*)(int);
     if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))
-      reinterpret_cast<SetThreads>(symbol)(1);
+      reinterpret_cast<SetThreads>(symbol)(kBlasThreads);
     return true;
   }();
   (void)done;
@@ -47,7 +51,7 @@ struct NewtonSolver::Factorisation {
   Eigen::CholmodSupernodalLLT<Matrix, Eigen::Lower> cholesky;
   bool analysed = false;
 
-  Factorisation() { use_one_blas_thread(); }
+  Factorisation() { fix_blas_threads(); }
 
   // Returns the number of shifted attempts (0: K itself), or -1 when none factorised.
   int factorise(const Matrix& K) {

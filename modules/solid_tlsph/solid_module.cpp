@@ -515,9 +515,26 @@ class SolidModule final : public StaticBodyModule<D> {
     for (int k = 0; k < spec_.pressures_size(); ++k) {
       const auto& spec = spec_.pressures(k);
       const std::string path = key_ + ".pressures[" + std::to_string(k) + "]";
-      auto shape = build_shape<D>(spec.region().shape(), path + ".region.shape");
       Pressure load;
       load.value = parse(spec.value(), path + ".value");
+      if (spec.has_face() == spec.has_region())
+        throw ConfigError(path, "a pressure needs either a region or a face (not both)");
+      if (spec.has_face()) {
+        if (spec.normal_size() > 0)
+          throw ConfigError(path + ".normal", "a face's normals are its own; give no normal");
+        const BoundaryFace<D>& face = find_face(spec.face(), path + ".face");
+        for (std::size_t m = 0; m < face.particles.size(); ++m) {
+          load.particles.push_back(static_cast<Index>(face.particles[m]));
+          load.areas.push_back(face.areas[m]);
+        }
+        pressures_.push_back(std::move(load));
+        continue;
+      }
+      if (lattice_placement(spec_.body()) == LatticePlacement::conforming)
+        throw ConfigError(path + ".region",
+                          "with placement conforming, name the pressure's face (inner, outer or "
+                          "base) instead of a region: the face's areas are exact");
+      auto shape = build_shape<D>(spec.region().shape(), path + ".region.shape");
       const Surface<D>& s = surface();
       const bool given = spec.normal_size() > 0;
       Vec<D> normal = Vec<D>::Zero();
@@ -537,6 +554,18 @@ class SolidModule final : public StaticBodyModule<D> {
         throw ConfigError(path + ".region", "the region contains no surface particle");
       pressures_.push_back(std::move(load));
     }
+  }
+
+  const BoundaryFace<D>& find_face(const std::string& name, const std::string& path) const {
+    std::string known;
+    for (const auto& face : Base::faces_) {
+      if (face.name == name) return face;
+      known += (known.empty() ? "" : ", ") + face.name;
+    }
+    throw ConfigError(path, known.empty()
+                                ? "the body's placement knows no faces (placement: conforming "
+                                  "on a truncated_ellipsoidal_shell does)"
+                                : "no face '" + name + "' (the body's faces: " + known + ")");
   }
 
   // The face area dA a surface particle carries, its volume over the depth of that volume under
@@ -890,7 +919,7 @@ class SolidModule final : public StaticBodyModule<D> {
     const std::vector<Vec<D>> start = u;
     NewtonSettings settings{spec_.steady_state().tolerance(),
                             spec_.steady_state().max_iterations()};
-    const NewtonOutcome outcome = equilibrium_->solve(t1, u, static_body_, settings);
+    const NewtonOutcome outcome = equilibrium_->solve(t0, t1, u, static_body_, settings);
     newton_iterations_ += outcome.iterations;
     factorisations_ += outcome.factorisations;
     shifted_factorisations_ += outcome.shifted_factorisations;

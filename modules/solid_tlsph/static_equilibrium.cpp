@@ -19,8 +19,8 @@ void StaticEquilibrium<D>::scatter(const Eigen::VectorXd& x, std::vector<Vec<D>>
 }
 
 template <int D>
-NewtonOutcome StaticEquilibrium<D>::solve(double t, std::vector<Vec<D>>& u, const Body& body,
-                                          const NewtonSettings& settings) {
+NewtonOutcome StaticEquilibrium<D>::solve(double t_start, double t, std::vector<Vec<D>>& u,
+                                          const Body& body, const NewtonSettings& settings) {
   body.prescribe(t, u);
   Eigen::VectorXd x(unknowns_);
   for (std::size_t k = 0; k < dof_.size(); ++k)
@@ -34,8 +34,10 @@ NewtonOutcome StaticEquilibrium<D>::solve(double t, std::vector<Vec<D>>& u, cons
       if (dof_[k] >= 0) r[dof_[k]] = force_[k / D][static_cast<int>(k % D)];
     return scale;
   };
+  bool first = true;
   const auto tangent = [&](const Eigen::VectorXd&) {
-    body.tangents(t, C_, loaded_, L_);
+    body.tangents(first ? t_start : t, C_, loaded_, L_);
+    first = false;
     return assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_, unknowns_);
   };
   const NewtonOutcome outcome = solver_.solve(x, residual, tangent, settings);

@@ -62,8 +62,12 @@ class StaticEquilibrium {
                     const std::vector<char>& prescribed);
 
   // Solves for u at load time t, starting from the u given (prescribed components are set
-  // first). On failure u holds the last accepted iterate.
-  NewtonOutcome solve(double t, std::vector<Vec<D>>& u, const Body& body,
+  // first), the equilibrium at load time t_start (t_start = t: no earlier equilibrium). The first
+  // tangent is that equilibrium's own, at the load of t_start: a stable equilibrium's tangent is
+  // positive definite, where the tangent of the start under the new load need not be (a follower
+  // pressure's load stiffness at full load on an unstressed body: Land's ventricle at u = 0 and
+  // 10 kPa). Later tangents take the load of t. On failure u holds the last accepted iterate.
+  NewtonOutcome solve(double t_start, double t, std::vector<Vec<D>>& u, const Body& body,
                       const NewtonSettings& settings);
 
   long long unknowns() const { return unknowns_; }

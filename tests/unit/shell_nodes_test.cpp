@@ -1,0 +1,113 @@
+// The conforming placement of the truncated ellipsoidal shell (framework/geometry/shell_nodes.cpp):
+// nodes on the walls and the base plane exactly, dual-cell volumes that sum to the shell's
+// analytic volume, and face area vectors that close (the body's boundary integrates to zero) and
+// give the analytic projected areas (the endocardium's is the base opening's disc).
+#include "geometry/shell_nodes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "geometry/shapes.hpp"
+
+namespace cosph {
+namespace {
+
+// Land et al. (2015) problems 2 and 3, in mm.
+const TruncatedEllipsoidalShell kLand(7.0, 17.0, 10.0, 20.0, 5.0);
+
+// The volume of the spheroid (a, a, c) below the plane z = h, |h| < c.
+double cap_volume(double a, double c, double h) {
+  return std::numbers::pi * a * a * ((h + c) - (h * h * h + c * c * c) / (3.0 * c * c));
+}
+
+double shell_volume() { return cap_volume(10.0, 20.0, 5.0) - cap_volume(7.0, 17.0, 5.0); }
+
+// The radius of the spheroid (a, a, c) at height z.
+double radius_at(double a, double c, double z) { return a * std::sqrt(1.0 - z * z / (c * c)); }
+
+const BoundaryFace<3>& face(const ParticleCloud<3>& cloud, const std::string& name) {
+  for (const auto& f : cloud.faces)
+    if (f.name == name) return f;
+  throw std::runtime_error("no face " + name);
+}
+
+Vec<3> face_sum(const BoundaryFace<3>& f) {
+  Vec<3> sum = Vec<3>::Zero();
+  for (const auto& a : f.areas) sum += a;
+  return sum;
+}
+
+TEST(ConformingShell, VolumesSumToTheShellsVolume) {
+  for (double spacing : {1.0, 0.75, 0.5}) {
+    const auto cloud = conforming_shell_nodes(kLand, spacing);
+    double total = 0.0;
+    for (double v : cloud.volumes) {
+      EXPECT_GT(v, 0.0);
+      total += v;
+    }
+    // Gauss-Legendre on a smooth integrand: round-off level (a first-order placement error, as
+    // a lattice's, would be ~1e-2).
+    EXPECT_NEAR(total / shell_volume(), 1.0, 1e-10) << "spacing " << spacing;
+    // Every node lies in the shell (within round-off of its faces).
+    for (const auto& x : cloud.positions) {
+      const double rho2 = x[0] * x[0] + x[1] * x[1];
+      EXPECT_LE(x[2], 5.0 + 1e-12);
+      EXPECT_LE(rho2 / 100.0 + x[2] * x[2] / 400.0, 1.0 + 1e-12);
+      EXPECT_GE(rho2 / 49.0 + x[2] * x[2] / 289.0, 1.0 - 1e-12);
+    }
+  }
+}
+
+TEST(ConformingShell, NodesSitOnTheFacesAndTheApices) {
+  const auto cloud = conforming_shell_nodes(kLand, 1.0);
+  for (std::size_t i : face(cloud, "inner").particles) {
+    const Vec<3>& x = cloud.positions[i];
+    EXPECT_NEAR((x[0] * x[0] + x[1] * x[1]) / 49.0 + x[2] * x[2] / 289.0, 1.0, 1e-12);
+  }
+  for (std::size_t i : face(cloud, "outer").particles) {
+    const Vec<3>& x = cloud.positions[i];
+    EXPECT_NEAR((x[0] * x[0] + x[1] * x[1]) / 100.0 + x[2] * x[2] / 400.0, 1.0, 1e-12);
+  }
+  for (std::size_t i : face(cloud, "base").particles)
+    EXPECT_NEAR(cloud.positions[i][2], 5.0, 1e-12);
+  // The benchmark's apex points are nodes: (0, 0, -17) and (0, 0, -20).
+  int apices = 0;
+  for (const auto& x : cloud.positions)
+    if (std::abs(x[0]) + std::abs(x[1]) == 0.0 &&
+        (std::abs(x[2] + 17.0) < 1e-12 || std::abs(x[2] + 20.0) < 1e-12))
+      ++apices;
+  EXPECT_EQ(apices, 2);
+  // Three wall intervals at 1 mm: four layers of nodes, the same count on both walls.
+  EXPECT_EQ(face(cloud, "inner").particles.size() > 100, true);
+}
+
+TEST(ConformingShell, FacesCloseAndProjectOntoTheBasePlane) {
+  for (double spacing : {1.0, 0.5}) {
+    const auto cloud = conforming_shell_nodes(kLand, spacing);
+    const Vec<3> inner = face_sum(face(cloud, "inner")), outer = face_sum(face(cloud, "outer")),
+                 base = face_sum(face(cloud, "base"));
+    const double r_in = radius_at(7.0, 17.0, 5.0), r_out = radius_at(10.0, 20.0, 5.0);
+    const double opening = std::numbers::pi * r_in * r_in;
+    const double annulus = std::numbers::pi * (r_out * r_out - r_in * r_in);
+    // The endocardium's outward (into the cavity) area is the opening's disc, +z; the base is the
+    // annulus, +z; the epicardium closes them, -z.
+    EXPECT_NEAR(inner[2] / opening, 1.0, 1e-10);
+    EXPECT_NEAR(base[2] / annulus, 1.0, 1e-10);
+    EXPECT_NEAR(outer[2] / (-opening - annulus), 1.0, 1e-10);
+    EXPECT_LT((inner + outer + base).norm(), 1e-10 * annulus);
+    // Rings are symmetric in v: no net sideways area.
+    EXPECT_LT(std::hypot(inner[0], inner[1]), 1e-10 * opening);
+  }
+}
+
+TEST(ConformingShell, RejectsAClosedCavityAndABadSpacing) {
+  EXPECT_THROW(conforming_shell_nodes(TruncatedEllipsoidalShell(7, 17, 10, 20, 18), 1.0),
+               std::invalid_argument);
+  EXPECT_THROW(conforming_shell_nodes(kLand, 0.0), std::invalid_argument);
+  EXPECT_THROW(conforming_shell_nodes(kLand, std::nan("")), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace cosph
