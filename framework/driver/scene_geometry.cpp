@@ -73,9 +73,10 @@ ShapePtr<D> make_shape(const proto::Shape& spec, const std::string& path) {
 // The nodes of a shape's own structured grid (placement: conforming); only the truncated
 // ellipsoidal shell has one.
 template <int D>
-ParticleCloud<D> conforming_body(const proto::BodySpec& spec, const std::string& key_path) {
+ParticleCloud<D> conforming_body(const proto::BodySpec& spec, const Shape<D>& shape,
+                                 const std::string& key_path) {
   if constexpr (D == 3) {
-    if (spec.shape().kind_case() == proto::Shape::kTruncatedEllipsoidalShell) {
+    if (const auto* shell = dynamic_cast<const TruncatedEllipsoidalShell*>(&shape)) {
       if (spec.lattice_anchor_size() > 0)
         throw ConfigError(key_path + ".lattice_anchor",
                           "a conforming placement follows the shape, not a lattice anchor");
@@ -83,13 +84,8 @@ ParticleCloud<D> conforming_body(const proto::BodySpec& spec, const std::string&
         throw ConfigError(key_path + ".perturbation",
                           "a conforming placement's faces are exact; perturbation would move "
                           "its face nodes off them");
-      const auto& s = spec.shape().truncated_ellipsoidal_shell();
       try {
-        return conforming_shell_nodes(
-            TruncatedEllipsoidalShell(s.inner_short_radius(), s.inner_long_radius(),
-                                      s.outer_short_radius(), s.outer_long_radius(),
-                                      s.truncation()),
-            spec.spacing());
+        return conforming_shell_nodes(*shell, spec.spacing());
       } catch (const std::invalid_argument& e) {
         throw ConfigError(key_path, e.what());
       }
@@ -131,7 +127,7 @@ ParticleCloud<D> build_body(const proto::BodySpec& spec, const std::string& key_
   }
   auto shape = build_shape<D>(spec.shape(), key_path + ".shape");
   if (lattice_placement(spec) == LatticePlacement::conforming)
-    return conforming_body<D>(spec, key_path);
+    return conforming_body<D>(spec, *shape, key_path);
   ParticleCloud<D> cloud;
   try {
     cloud = lattice_fill<D>(*shape, spec.spacing(), to_vec<D>(spec.lattice_anchor()),
