@@ -639,6 +639,7 @@ class SolidModule final : public StaticBodyModule<D> {
     const bool viscosity = spec_.has_artificial_viscosity();
     const bool hourglass = spec_.has_hourglass_control();
     update_active_tension(t);
+    const std::size_t grain = pair_loop_grain(n, pairs_.neighbours.pair_count());
     parallel_for_each_index(n, [&](std::size_t i) {
       const Mat<D>& F = F_[i] = deformation_gradient<D>(pairs_, u, i);
       const Mat<D> frame = frames_.empty() ? Mat<D>::Identity() : frames_[i];
@@ -649,7 +650,7 @@ class SolidModule final : public StaticBodyModule<D> {
         A_[i] = J * F.inverse().transpose();
         density_[i] = material_.density() / J;
       }
-    });
+    }, grain);
     const double rho0 = material_.density();
     const Vec<D> gravity = body_force_ * load_factor(t);
     const ViscosityParameters viscous{spec_.artificial_viscosity().alpha(),
@@ -661,7 +662,7 @@ class SolidModule final : public StaticBodyModule<D> {
       if (viscosity) force += artificial_viscosity<D>(pairs_, x_, v, density_, A_, viscous, i);
       if (hourglass) force += hourglass_force<D>(pairs_, X_, x_, F_, stiffness, i);
       a[i] = force / rho0 + gravity;
-    });
+    }, grain);
     const auto& mass = particles_.scalar("mass");
     const double factor = load_factor(t);
     for (const auto& load : pressures_)
