@@ -153,6 +153,7 @@ class Study:
     repeat: int
     order: Optional[int]
     comparisons: tuple = ()
+    timeout: Optional[float] = None  # seconds a run may take (the runner's default if None)
 
     def points(self) -> list:
         """The cartesian product of the axes, then the explicit points."""
@@ -250,7 +251,7 @@ def load_study(path: Path) -> Study:
 def _parse_study(path: Path, root: Any) -> Study:
     _check_keys(root, "study", ("title", "description", "scene", "sweep", "quantity",
                                 "reference", "norm"),
-                ("name", "overrides", "threshold", "repeat", "order", "comparisons"))
+                ("name", "overrides", "threshold", "repeat", "order", "comparisons", "timeout"))
     scene = (path.parent / _string(root["scene"], "scene")).resolve()
     if not scene.is_file():
         raise StudyError(f"scene: no such file: {scene}")
@@ -277,12 +278,18 @@ def _parse_study(path: Path, root: Any) -> Study:
     if order is not None and (not isinstance(order, int) or isinstance(order, bool)):
         raise StudyError(f"order: expected an integer, got {order!r}")
     comparisons = _parse_comparisons(root.get("comparisons"), path.parent, quantity)
+    timeout = root.get("timeout")
+    if timeout is not None:
+        timeout = _number(timeout, "timeout")
+        if not timeout > 0:
+            raise StudyError(f"timeout: expected seconds > 0, got {timeout!r}")
     return Study(path=path.resolve(), name=_string(root.get("name", path.stem), "name"),
                  title=_string(root["title"], "title"),
                  description=_string(root["description"], "description"), scene=scene,
                  overrides=_overrides(root.get("overrides"), "overrides"), axes=axes,
                  explicit_points=explicit, quantity=quantity, reference=reference, norm=norm,
-                 threshold=threshold, repeat=repeat, order=order, comparisons=comparisons)
+                 threshold=threshold, repeat=repeat, order=order, comparisons=comparisons,
+                 timeout=timeout)
 
 
 def _parse_comparisons(node: Any, base: Path, quantity: Quantity) -> tuple:
@@ -1297,7 +1304,8 @@ def parse_args(argv: Optional[list]) -> argparse.Namespace:
                         help="runs per point; the minimum wall time counts (default: the "
                              "study's 'repeat', else 1)")
     parser.add_argument("--timeout", type=float, default=900.0,
-                        help="seconds before one run counts as failed (default: %(default)s)")
+                        help="seconds before one run counts as failed, where the study sets no timeout "
+                             "(default: %(default)s)")
     parser.add_argument("--cache", type=Path, metavar="DIR",
                         help="reuse runs with the same executable, scene and overrides from DIR "
                              "(and keep new ones there)")
@@ -1330,7 +1338,7 @@ def main(argv: Optional[list] = None) -> int:
     print(f"study {study.name}: {len(study.points())} point(s), scene {study.scene}, "
           f"output {out_dir}")
     try:
-        done = run_study(study, cosph, out_dir, repeat, args.timeout,
+        done = run_study(study, cosph, out_dir, repeat, study.timeout or args.timeout,
                          cache=args.cache.resolve() if args.cache else None)
     except OSError as error:
         print(f"study.py: error: cannot write the results: {error}", file=sys.stderr)

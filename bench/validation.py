@@ -291,7 +291,7 @@ def main(argv: Optional[list] = None) -> int:
             print(f"== {study.name} ({len(study.points())} points)")
             out_dir = REPO_ROOT / "bench" / "results" / study.name
             runs.append(studies.run_study(study, cosph, out_dir, args.repeat or study.repeat,
-                                          timeout=900.0,
+                                          timeout=study.timeout or 900.0,
                                           cache=REPO_ROOT / "bench" / "results" / "runs",
                                           refresh=args.fresh))
         write_document(args.output.resolve(), runs, machine, time.monotonic() - start)

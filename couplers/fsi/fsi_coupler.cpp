@@ -187,6 +187,10 @@ class FsiCoupler final : public Coupler {
     contact_.points = after_.points;
     contact_.arrays["position"] = after_.arrays.at("position");
     contact_.arrays["volume"] = after_.arrays.at("volume");
+    // Its masses, where the solid offers them, bound the fluid's exchange interval under a
+    // sub-cycled viscous force (the fluid's contact_viscous_dt).
+    if (auto m = after_.arrays.find("mass"); m != after_.arrays.end())
+      contact_.arrays["mass"] = m->second;
     contact_.arrays["velocity"] = {dimension_, velocity_average_};
     // Without it the fluid extends its pressure to the solid with gravity alone.
     if (solid_acceleration_in_pressure_)

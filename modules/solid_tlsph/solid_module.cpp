@@ -58,7 +58,7 @@ class SolidModule final : public StaticBodyModule<D> {
     // the point set a fluid's contact sees (it must see all solid particles within its kernel
     // support: one surface layer under-fills it, and a thin flag is seen from both sides).
     info.writes = {{"interface", {"position", "normal", "volume", "velocity", "acceleration"}},
-                   {"particles", {"position", "volume", "velocity", "acceleration"}}};
+                   {"particles", {"position", "volume", "velocity", "acceleration", "mass"}}};
     info.reads = {{"external_force", {"force"}}, {"active_stress", {"active_stress"}}};
     auto& f = info.active_features;
     f.push_back("material " + material_.name());
@@ -395,6 +395,7 @@ class SolidModule final : public StaticBodyModule<D> {
     out.points = particles_.size();
     out.arrays.clear();
     out.arrays["volume"] = {1, particles_.scalar("volume")};
+    out.arrays["mass"] = {1, particles_.scalar("mass")};
     for (const char* f : {"position", "velocity", "acceleration"}) {
       const auto raw = particles_.raw(f);
       out.arrays[f] = {D, std::vector<double>(raw.begin(), raw.end())};
@@ -640,29 +641,35 @@ class SolidModule final : public StaticBodyModule<D> {
     const bool hourglass = spec_.has_hourglass_control();
     update_active_tension(t);
     const std::size_t grain = pair_loop_grain(n, pairs_.neighbours.pair_count());
-    parallel_for_each_index(n, [&](std::size_t i) {
-      const Mat<D>& F = F_[i] = deformation_gradient<D>(pairs_, u, i);
-      const Mat<D> frame = frames_.empty() ? Mat<D>::Identity() : frames_[i];
-      P_[i] = first_piola(i, F, frame);
-      x_[i] = X_[i] + u[i];
-      if (viscosity) {
-        const double J = F.determinant();
-        A_[i] = J * F.inverse().transpose();
-        density_[i] = material_.density() / J;
-      }
-    }, grain);
+    parallel_for_each_index(
+        n,
+        [&](std::size_t i) {
+          const Mat<D>& F = F_[i] = deformation_gradient<D>(pairs_, u, i);
+          const Mat<D> frame = frames_.empty() ? Mat<D>::Identity() : frames_[i];
+          P_[i] = first_piola(i, F, frame);
+          x_[i] = X_[i] + u[i];
+          if (viscosity) {
+            const double J = F.determinant();
+            A_[i] = J * F.inverse().transpose();
+            density_[i] = material_.density() / J;
+          }
+        },
+        grain);
     const double rho0 = material_.density();
     const Vec<D> gravity = body_force_ * load_factor(t);
     const ViscosityParameters viscous{spec_.artificial_viscosity().alpha(),
                                       spec_.artificial_viscosity().beta(), material_.wave_speed(),
                                       kernel_.smoothing_length()};
     const double stiffness = spec_.hourglass_control().coefficient() * material_.young_modulus();
-    parallel_for_each_index(n, [&](std::size_t i) {
-      Vec<D> force = pair_stress_divergence<D>(pairs_, P_, i);
-      if (viscosity) force += artificial_viscosity<D>(pairs_, x_, v, density_, A_, viscous, i);
-      if (hourglass) force += hourglass_force<D>(pairs_, X_, x_, F_, stiffness, i);
-      a[i] = force / rho0 + gravity;
-    }, grain);
+    parallel_for_each_index(
+        n,
+        [&](std::size_t i) {
+          Vec<D> force = pair_stress_divergence<D>(pairs_, P_, i);
+          if (viscosity) force += artificial_viscosity<D>(pairs_, x_, v, density_, A_, viscous, i);
+          if (hourglass) force += hourglass_force<D>(pairs_, X_, x_, F_, stiffness, i);
+          a[i] = force / rho0 + gravity;
+        },
+        grain);
     const auto& mass = particles_.scalar("mass");
     const double factor = load_factor(t);
     for (const auto& load : pressures_)

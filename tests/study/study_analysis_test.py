@@ -91,15 +91,15 @@ quantity: {{probe: tip, kind: {kind}, column: z}}
 reference: {{value: 4.17, source: s{band}}}
 comparisons: [{{label: seed, source: table 1, csv: table.csv, columns: [particles, z]}}]
 norm: {norm}
-"""
+{extra}"""
 
-    def load(self, kind="final", norm="relative_at_point", band=""):
+    def load(self, kind="final", norm="relative_at_point", band="", extra=""):
         with tempfile.TemporaryDirectory() as directory:
             root = Path(directory)
             (root / "scene.yaml").write_text(self.SCENE)
             (root / "table.csv").write_text("# a comment\nparticles,z\n4544,4.217\n1025,4.707\n")
             path = root / "study.yaml"
-            path.write_text(self.STUDY.format(kind=kind, norm=norm, band=band))
+            path.write_text(self.STUDY.format(kind=kind, norm=norm, band=band, extra=extra))
             return study.load_study(path)
 
     def test_table_is_read_sorted_by_particle_count_and_band_kept(self):
@@ -117,6 +117,14 @@ norm: {norm}
             self.load(band=", band: {low: 4.2, high: 4.0, label: FEM}")
         with self.assertRaisesRegex(study.StudyError, "reference.band.*colour"):
             self.load(band=", band: {low: 4.0, high: 4.2, label: FEM, colour: red}")
+
+    def test_a_study_may_give_its_runs_more_time(self):
+        self.assertIsNone(self.load().timeout)
+        self.assertEqual(self.load(extra="timeout: 2400").timeout, 2400.0)
+        with self.assertRaisesRegex(study.StudyError, "timeout: expected seconds > 0"):
+            self.load(extra="timeout: 0")
+        with self.assertRaisesRegex(study.StudyError, "timeout: expected a number"):
+            self.load(extra="timeout: long")
 
 
 if __name__ == "__main__":
