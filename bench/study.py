@@ -1303,9 +1303,9 @@ def parse_args(argv: Optional[list]) -> argparse.Namespace:
     parser.add_argument("--repeat", type=int,
                         help="runs per point; the minimum wall time counts (default: the "
                              "study's 'repeat', else 1)")
-    parser.add_argument("--timeout", type=float, default=900.0,
-                        help="seconds before one run counts as failed, where the study sets no timeout "
-                             "(default: %(default)s)")
+    parser.add_argument("--timeout", type=float, default=None,
+                        help="seconds before one run counts as failed (default: the study's "
+                             "'timeout', else 900)")
     parser.add_argument("--cache", type=Path, metavar="DIR",
                         help="reuse runs with the same executable, scene and overrides from DIR "
                              "(and keep new ones there)")
@@ -1338,7 +1338,7 @@ def main(argv: Optional[list] = None) -> int:
     print(f"study {study.name}: {len(study.points())} point(s), scene {study.scene}, "
           f"output {out_dir}")
     try:
-        done = run_study(study, cosph, out_dir, repeat, study.timeout or args.timeout,
+        done = run_study(study, cosph, out_dir, repeat, args.timeout or study.timeout or 900.0,
                          cache=args.cache.resolve() if args.cache else None)
     except OSError as error:
         print(f"study.py: error: cannot write the results: {error}", file=sys.stderr)

@@ -35,8 +35,9 @@ std::string find_port(const ModuleInfo& info, bool writes, const std::string& po
 //     the solid's velocity (and, if the scene asks, acceleration) averaged over the solid's
 //     sub-steps of the previous acoustic step;
 //  2. the fluid's force on every solid particle in that sub-step — the reaction of the Riemann
-//     pressures the fluid used, plus the viscous force of the advection step — goes to the
-//     solid's external force, so the impulse balances to round-off;
+//     pressures the fluid used, plus the viscous force of the advection step (or of the
+//     sub-step, where the fluid sub-cycles it) — goes to the solid's external force, so the
+//     impulse balances to round-off;
 //  3. the solid advances over dt_ac in kappa = floor(dt_ac / dt_solid) + 1 equal sub-steps with
 //     that force held;
 //  4. its average velocity (displacement / dt_ac) and acceleration (velocity change / dt_ac) over

@@ -18,14 +18,15 @@ namespace cosph {
 inline constexpr std::size_t kPairGrain = 256;
 inline constexpr std::size_t kStreamGrain = 8192;
 
-// Pairs a task of a pair loop should hold to pay for its fork and join (about 10 us of work).
+// Pairs a task of a pair loop should hold to pay for its fork and join (about 10 us of work;
+// oneTBB halves a range while it is longer than the grain, so a task holds half to all of it).
 // A solid of a few hundred particles (8,000 pairs) sub-stepped half a million times in an FSI run
 // is faster on the calling thread alone: the 416-particle hydrostatic plate's whole run took 13%
 // less wall time with its pair loops unsplit.
 inline constexpr std::size_t kPairsPerTask = 16384;
 
-// The grain of a pair loop over n indices with `pairs` pairs in all: at least kPairsPerTask pairs
-// a task, never finer than kPairGrain.
+// The grain of a pair loop over n indices with `pairs` pairs in all: kPairsPerTask pairs' worth of
+// indices, never finer than kPairGrain; a loop of fewer pairs is not split.
 inline std::size_t pair_loop_grain(std::size_t n, std::size_t pairs) {
   if (pairs == 0) return kPairGrain;
   return std::max(kPairGrain, (kPairsPerTask * n + pairs - 1) / pairs);

@@ -22,8 +22,8 @@ struct PairGeometry {
   std::vector<Vec<D>> direction;
   std::vector<double> gradient;  // -dW/dr
   std::vector<double> distance;
-  // -dW/dr / r, only with viscosity: its force is recomputed at every acoustic sub-step when the
-  // viscous limit is below the advection step, and the division would be redone each time.
+  // -dW/dr / r, only with viscosity: its force is recomputed at every split step when the viscous
+  // limit is below the advection step, and the division would be redone each time.
   std::vector<double> gradient_over_distance;
 };
 
@@ -41,8 +41,10 @@ struct BoundarySet {
   // The fluid's force on each boundary particle, recorded pair by pair inside the fluid's own
   // loops (only for sets whose force is asked for: a coupler's contact body, walls with the
   // `wall_force` output): the pressure force of the last acoustic sub-step, the reaction of the
-  // very Riemann pressures the fluid used in it, and the viscous force of the advection step. The
-  // impulse the fluid receives is then exactly opposite to what the boundary receives.
+  // very Riemann pressures the fluid used in it, and the viscous force of the advection step (of
+  // the last acoustic sub-step, the mean over its split steps, where the viscous force is
+  // sub-cycled). The impulse the fluid receives is then exactly opposite to what the boundary
+  // receives.
   bool records = false;
   std::vector<Vec<D>> pair_pressure_force, pair_viscous_force;
   NeighbourList pairs_of;  // boundary particle -> indices of its pairs in `list`

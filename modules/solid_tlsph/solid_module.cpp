@@ -390,7 +390,7 @@ class SolidModule final : public StaticBodyModule<D> {
     return Base::parse_expression(text, kSpaceTime, key);
   }
 
-  // Every particle's position, reference volume, velocity and acceleration.
+  // Every particle's position, reference volume, velocity, acceleration and mass.
   void write_particles(FieldBuffer& out) const {
     out.points = particles_.size();
     out.arrays.clear();

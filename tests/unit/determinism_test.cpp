@@ -233,6 +233,17 @@ TEST(Determinism, FsiDamBreakOnAPlate3D) {
                     "fsi_plate_3d");
 }
 
+// The fluid's viscous force sub-cycled against a contact body: the hydrostatic plate with
+// eta = 3000 Pa s takes two split steps per acoustic sub-step (limit 3.5e-4 s, sub-step 4.4e-4 s)
+// and hands the plate their mean force.
+TEST(Determinism, FsiPlateUnderASubCycledViscousForce) {
+  check_determinism({example("fsi_hydrostatic_plate.yaml"),
+                     {"modules[0].fluid.viscosity=3000", "output.interval=0.01"},
+                     0.02,
+                     10},
+                    "fsi_plate_viscous");
+}
+
 // Several modules side by side, with probes on each: the order of the roots, the nesting of
 // their checkpoint records and each probe's module are kept across the restart.
 TEST(Determinism, SeveralModulesInOneScene) {

@@ -149,6 +149,23 @@ TEST(Fluid, ViscosityBelowTheAdvectionStepIsSubCycledNotTheStep) {
   EXPECT_LT((momentum() - start).norm(), 1e-12 * scale);
 }
 
+// A viscosity that would take a million split steps in one acoustic sub-step is a broken scene:
+// it stops with the module, the number of split steps and the viscosity named, instead of
+// running for days.
+TEST(Fluid, AViscosityNeedingAMillionSplitStepsStopsTheRun) {
+  auto s = make_simulation(kPeriodicBox, {"modules[0].fluid.viscosity=1e10"});
+  Module& fluid = s->module(0);
+  fluid.begin_step(fluid.max_dt());
+  try {
+    fluid.substep(fluid.max_substep());
+    ADD_FAILURE() << "no error";
+  } catch (const RuntimeError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("module 'water': the viscous force would need"), std::string::npos) << what;
+    EXPECT_NE(what.find("eta = 10000000000"), std::string::npos) << what;
+  }
+}
+
 const char* kTank = R"yaml(
 dimension: 2
 end_time: 2.0
