@@ -41,9 +41,12 @@ DEFAULT_COSPH = REPO_ROOT / "build" / "release" / "app" / "cosph"
 # mean, maximum, amplitude: one value of a time series (amplitude = (max - min) / 2);
 # dominant_period, dominant_amplitude: the period and amplitude of the strongest sinusoid of a
 # noisy oscillation (the peak of a Hann-windowed, zero-padded spectrum), e.g. the lift of a
-# cylinder shedding vortices under acoustic noise.
+# cylinder shedding vortices under acoustic noise;
+# cycle_mean, cycle_amplitude: (max + min) / 2 and (max - min) / 2 of each whole period (the
+# dominant one) in the window, averaged over the periods: Turek & Hron's "mean +- amplitude",
+# which for a signal with harmonics differs from the time mean and the strongest sinusoid.
 SCALAR_KINDS = ("period", "mean", "maximum", "amplitude", "dominant_period",
-                "dominant_amplitude")
+                "dominant_amplitude", "cycle_mean", "cycle_amplitude")
 KINDS = ("profile", "time_series", "final") + SCALAR_KINDS
 # Which quantity kinds each norm makes sense for: a spatial L2 needs a profile, an arrival time
 # needs a time series, a relative error at a point needs a single value.
@@ -862,6 +865,25 @@ def dominant_oscillation(times, series) -> tuple:
     return 1.0 / frequencies[peak], 2.0 * spectrum[peak] / window.sum()
 
 
+def cycle_statistics(times, series) -> tuple:
+    """(mean, amplitude) as benchmarks of periodic flows state them: over each whole period of
+    the dominant oscillation, counted from the window's start, (max + min) / 2 and
+    (max - min) / 2; each averaged over the periods. Any interval one period long holds one
+    maximum and one minimum, so the split needs no zero crossings, which harmonics and noise
+    multiply."""
+    # dominant_oscillation finds no period longer than half the window: two cycles at least.
+    period, _ = dominant_oscillation(times, series)
+    cycles = int(np.floor((times[-1] - times[0]) / period * (1.0 + 1e-9)))
+    means, amplitudes = [], []
+    for cycle in range(cycles):
+        start = times[0] + cycle * period
+        inside = (times >= start) & (times <= start + period)
+        high, low = float(np.max(series[inside])), float(np.min(series[inside]))
+        means.append(0.5 * (high + low))
+        amplitudes.append(0.5 * (high - low))
+    return float(np.mean(means)), float(np.mean(amplitudes))
+
+
 def _prepare_series(quantity: Quantity, times, series) -> tuple:
     """The series smoothed by a centred moving average (over the whole record, so the window's
     edges are averaged with their neighbours), then cut to the window."""
@@ -901,6 +923,8 @@ SERIES_VALUES = {
     "amplitude": lambda q, t, s: 0.5 * float(np.max(s) - np.min(s)),
     "dominant_period": lambda q, t, s: dominant_oscillation(t, s)[0],
     "dominant_amplitude": lambda q, t, s: dominant_oscillation(t, s)[1],
+    "cycle_mean": lambda q, t, s: cycle_statistics(t, s)[0],
+    "cycle_amplitude": lambda q, t, s: cycle_statistics(t, s)[1],
 }
 
 
@@ -1092,7 +1116,9 @@ def quantity_text(quantity: Quantity) -> str:
             "crossings of", "mean": "time mean of", "maximum": "largest value of",
             "amplitude": "half the peak-to-peak range of",
             "dominant_period": "period of the strongest sinusoid in",
-            "dominant_amplitude": "amplitude of the strongest sinusoid in"}
+            "dominant_amplitude": "amplitude of the strongest sinusoid in",
+            "cycle_mean": "mean over its periods of (max + min) / 2 of",
+            "cycle_amplitude": "mean over its periods of (max - min) / 2 of"}
     if quantity.kind in what:
         return f"{name}{what[quantity.kind]} {quantity.column}{extra}"
     return f"{name}final value of {quantity.column}"

@@ -32,6 +32,26 @@ class DominantOscillation(unittest.TestCase):
             study.dominant_oscillation(np.linspace(0, 1, 50), np.ones(50))
 
 
+class CycleStatistics(unittest.TestCase):
+    def test_mean_and_amplitude_are_the_benchmarks_not_the_sinusoids(self):
+        # c + A (sin + 0.1 sin 3x): extremes +-0.9 A (at x = pi/2 for 0.1 < 1/9), so the benchmark's
+        # amplitude is 0.9 A where the strongest sinusoid's is A. c + A sin + B sin^2 (A > 2B):
+        # extremes c + B +- A, so its mean is c + B where the time mean is c + B / 2.
+        t = np.arange(0.0, 6.0 + 1e-9, 0.002)
+        x = 2 * np.pi * t / 0.53
+        mean, amplitude = study.cycle_statistics(t, 0.3 + 2.0 * (np.sin(x) + 0.1 * np.sin(3 * x)))
+        self.assertAlmostEqual(amplitude, 1.8, delta=1e-3)
+        self.assertAlmostEqual(mean, 0.3, delta=1e-3)
+        self.assertAlmostEqual(study.dominant_oscillation(t, 2.0 * np.sin(x))[1], 2.0, delta=0.02)
+        mean, amplitude = study.cycle_statistics(t, 0.3 + 2.0 * np.sin(x) + 0.5 * np.sin(x) ** 2)
+        self.assertAlmostEqual(mean, 0.8, delta=1e-3)
+        self.assertAlmostEqual(amplitude, 2.0, delta=1e-3)
+
+    def test_constant_series_is_refused(self):
+        with self.assertRaises(study.ComparisonError):
+            study.cycle_statistics(np.linspace(0, 1, 50), np.ones(50))
+
+
 class SeriesPreparation(unittest.TestCase):
     def test_window_cuts_and_smoothing_is_centred(self):
         t = np.arange(0.0, 1.0001, 0.01)
