@@ -10,6 +10,13 @@
 namespace cosph {
 namespace {
 
+// A number with six significant digits: a step of 1e-9 s reads as such, not as 0.000000.
+std::string significant(double x) {
+  std::ostringstream out;
+  out << x;
+  return out.str();
+}
+
 // The full name of the port a child offers as `port`: its own port, or a nested child's
 // ("solid.port" when the child is itself a coupler). Empty if none, or if two children offer it.
 std::string find_port(const ModuleInfo& info, bool writes, const std::string& port,
@@ -93,15 +100,17 @@ class FsiCoupler final : public Coupler {
       solid().read(external_force_port_, force_);
       const double solid_dt = solid().max_dt();
       if (!(solid_dt > 0.0) || !std::isfinite(solid_dt))
-        throw RuntimeError("FSI coupler: the solid's stable step is " + std::to_string(solid_dt) +
-                           " at t = " + std::to_string(fluid().time()));
+        throw RuntimeError("FSI coupler: the solid's stable step is " + significant(solid_dt) +
+                           " at t = " + significant(fluid().time()));
       // Thousands of sub-steps per acoustic step are normal for stiff gates (measured up to
-      // ~400); a million means a broken state (a restored step limit gone wrong), not physics.
+      // ~400); a million means a broken state (a restored step limit gone wrong, or a solid gone
+      // unstable), not physics.
       if (!(dt / solid_dt < kMaxSubsteps))
-        throw RuntimeError("FSI coupler: the solid's stable step " + std::to_string(solid_dt) +
-                           " would take more than " + std::to_string(long(kMaxSubsteps)) +
-                           " sub-steps of the fluid's acoustic step " + std::to_string(dt) +
-                           " at t = " + std::to_string(fluid().time()));
+        throw RuntimeError("FSI coupler: the solid's stable step " + significant(solid_dt) +
+                           " s would take more than " + std::to_string(long(kMaxSubsteps)) +
+                           " sub-steps of the fluid's acoustic step " + significant(dt) +
+                           " s at t = " + significant(fluid().time()) +
+                           " (a solid gone unstable, or a step limit restored wrong)");
       const long long kappa = static_cast<long long>(std::floor(dt / solid_dt)) + 1;
       for (long long k = 0; k < kappa; ++k) solid().advance(dt / double(kappa));
       solid().write(particles_port_, after_);
