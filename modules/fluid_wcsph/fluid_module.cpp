@@ -75,7 +75,9 @@ class FluidModule final : public Module {
                 : spec_.riemann_solver() == "continuity_only" ? "Riemann solver, continuity only"
                                                               : "low-dissipation Riemann solver");
     f.push_back("density " + spec_.density_treatment());
-    f.push_back("dual-criteria time stepping");
+    f.push_back(spec_.whole_acoustic_substeps()
+                    ? "dual-criteria time stepping (whole acoustic sub-steps)"
+                    : "dual-criteria time stepping");
     if (spec_.viscosity() > 0.0) f.push_back("viscosity");
     if (spec_.gravity_size() > 0) f.push_back("gravity");
     if (spec_.transport_velocity())
@@ -138,10 +140,15 @@ class FluidModule final : public Module {
   // acoustic sub-step in as many split steps of at most viscous_dt as the sub-step needs
   // (apply_viscosity), while the neighbour lists and the density summation stay once per
   // advection step and the acoustic sub-step stays the sound speed's (or a contact body's
-  // viscous limit, contact_viscous_dt).
+  // viscous limit, contact_viscous_dt). With whole_acoustic_substeps the step is rounded up to
+  // a whole number of the acoustic sub-steps it would hold.
   double max_dt() const override {
-    const double speed = std::max(max_speed(), 0.1 * sound_speed_);
-    return spec_.advection_cfl() * kernel_.smoothing_length() / speed;
+    const double speed = max_speed();
+    const double advection =
+        spec_.advection_cfl() * kernel_.smoothing_length() / std::max(speed, 0.1 * sound_speed_);
+    if (!spec_.whole_acoustic_substeps()) return advection;
+    const double acoustic = acoustic_dt(speed, viscous_dt() < advection);
+    return std::ceil(advection / acoustic * (1.0 - 1e-9)) * acoustic;
   }
 
   double viscous_dt() const {
@@ -168,15 +175,24 @@ class FluidModule final : public Module {
   // Whether the open advection step sub-cycles the viscous force (see max_dt).
   bool viscous_substeps() const { return viscous_dt() < step_size_; }
 
-  // The acoustic step (dt = 0.6 h / (c + |v|max)), cut to what is left of the advection step.
+  // The acoustic step (dt = 0.6 h / (c + |v|max)), cut to what is left of the advection step;
+  // with whole_acoustic_substeps, what is left split into equal sub-steps within the limit.
   double max_substep() const override {
     if (step_done_ >= step_size_ * (1.0 - 1e-12)) return 0.0;
-    const double h = kernel_.smoothing_length();
     const double speed = max_speed();
     if (!(speed <= sound_speed_)) throw_supersonic(time_ + step_done_);
-    double dt = spec_.acoustic_cfl() * h / (sound_speed_ + speed);
-    if (viscous_substeps()) dt = std::min(dt, contact_viscous_dt());
-    return std::min(dt, step_size_ - step_done_);
+    const double dt = acoustic_dt(speed, viscous_substeps());
+    const double left = step_size_ - step_done_;
+    if (!spec_.whole_acoustic_substeps()) return std::min(dt, left);
+    // The tolerance keeps a step of exactly n sub-steps (max_dt) at n, not n + 1 by round-off.
+    return left / std::ceil(left / dt * (1.0 - 1e-9));
+  }
+
+  // The acoustic limit, and the contact body's viscous limit where the viscous force is
+  // sub-cycled.
+  double acoustic_dt(double speed, bool viscous_substeps) const {
+    const double dt = spec_.acoustic_cfl() * kernel_.smoothing_length() / (sound_speed_ + speed);
+    return viscous_substeps ? std::min(dt, contact_viscous_dt()) : dt;
   }
 
   // A contact body is handed the viscous force of an acoustic sub-step and answers only after it:

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <vector>
 
 #include "../support/probe_csv.hpp"
 #include "../support/simulation_setup.hpp"
@@ -147,6 +148,44 @@ TEST(Fluid, ViscosityBelowTheAdvectionStepIsSubCycledNotTheStep) {
     energy = now;
   }
   EXPECT_LT((momentum() - start).norm(), 1e-12 * scale);
+}
+
+// whole_acoustic_substeps rounds the advection step up to a whole number of acoustic sub-steps
+// of one length (SPHinXsys's loop) instead of cutting the last sub-step to the advection step:
+// here 0.25 h / (c / 10) = 1.63e-2 holds 4.3 acoustic sub-steps of 0.6 h / (c + |v|max), so the
+// cut scheme takes five sub-steps, the last a third long, and the rounded one five full ones.
+// A step the driver cuts (an output time) is split into equal sub-steps within the limit.
+TEST(Fluid, WholeAcousticSubstepsRoundTheAdvectionStepUp) {
+  auto cut = make_simulation(kPeriodicBox, {});
+  auto whole = make_simulation(kPeriodicBox, {"modules[0].fluid.whole_acoustic_substeps=true"});
+  Module& fluid = whole->module(0);
+  const double advection = cut->module(0).max_dt();
+  cut->module(0).begin_step(advection);
+  const double acoustic = cut->module(0).max_substep();
+  ASSERT_GT(advection / acoustic, 4.1);
+  ASSERT_LT(advection / acoustic, 4.9);
+  const double Dt = fluid.max_dt();
+  EXPECT_NEAR(Dt, 5.0 * acoustic, 1e-12 * Dt);
+  auto substeps = [&](double step) {
+    std::vector<double> taken;
+    fluid.begin_step(step);
+    for (double dt; (dt = fluid.max_substep()) > 0.0;) {
+      taken.push_back(dt);
+      fluid.substep(dt);
+    }
+    fluid.end_step();
+    return taken;
+  };
+  const std::vector<double> full = substeps(Dt);
+  ASSERT_EQ(full.size(), 5u);
+  for (double dt : full) EXPECT_NEAR(dt, acoustic, 1e-3 * acoustic);  // |v|max moves a little
+  const double limit = fluid.max_dt() / 5.0 * (1.0 + 1e-9);
+  const std::vector<double> shortened = substeps(0.55 * fluid.max_dt());  // 2.75 sub-steps
+  ASSERT_EQ(shortened.size(), 3u);
+  for (double dt : shortened) {
+    EXPECT_NEAR(dt, shortened[0], 1e-12 * dt);
+    EXPECT_LE(dt, limit);
+  }
 }
 
 // A viscosity that would take a million split steps in one acoustic sub-step is a broken scene:
