@@ -586,7 +586,8 @@ class FluidModule final : public Module {
 
   // Neighbour lists and, per pair, the unit vector e_ij (from i to j) and -dW/dr at the
   // configuration of the advection step. The acoustic sub-steps reuse them (as SPHinXsys does):
-  // particles move less than a quarter smoothing length per advection step.
+  // particles move less than a quarter smoothing length per advection step (under 0.25 h + 0.6 h
+  // |v| / (c + |v|) with whole_acoustic_substeps).
   void build_neighbours() {
     const auto& x = fluid_.vector("position");
     inner_ = build_inner_list<D>(x, kernel_.support_radius(), domain_);
