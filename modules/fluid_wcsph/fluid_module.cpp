@@ -148,7 +148,13 @@ class FluidModule final : public Module {
         spec_.advection_cfl() * kernel_.smoothing_length() / std::max(speed, 0.1 * sound_speed_);
     if (!spec_.whole_acoustic_substeps()) return advection;
     const double acoustic = acoustic_dt(speed, viscous_dt() < advection);
-    return std::ceil(advection / acoustic * (1.0 - 1e-9)) * acoustic;
+    return whole_substeps(advection, acoustic) * acoustic;
+  }
+
+  // The number of sub-steps of at most dt that cover span. The tolerance keeps a span of exactly
+  // n sub-steps (max_dt's) at n, not n + 1 by round-off.
+  static double whole_substeps(double span, double dt) {
+    return std::ceil(span / dt * (1.0 - 1e-9));
   }
 
   double viscous_dt() const {
@@ -184,8 +190,7 @@ class FluidModule final : public Module {
     const double dt = acoustic_dt(speed, viscous_substeps());
     const double left = step_size_ - step_done_;
     if (!spec_.whole_acoustic_substeps()) return std::min(dt, left);
-    // The tolerance keeps a step of exactly n sub-steps (max_dt) at n, not n + 1 by round-off.
-    return left / std::ceil(left / dt * (1.0 - 1e-9));
+    return left / whole_substeps(left, dt);
   }
 
   // The acoustic limit, and the contact body's viscous limit where the viscous force is
