@@ -244,6 +244,16 @@ TEST(Determinism, FsiPlateUnderASubCycledViscousForce) {
                     "fsi_plate_viscous");
 }
 
+// The fluid's advection step rounded up to whole acoustic sub-steps against a contact body: the
+// checkpoint and output times shorten steps, which are then split into equal sub-steps.
+TEST(Determinism, FsiPlateWithWholeAcousticSubsteps) {
+  check_determinism({example("fsi_hydrostatic_plate.yaml"),
+                     {"modules[0].fluid.whole_acoustic_substeps=true", "output.interval=0.01"},
+                     0.02,
+                     10},
+                    "fsi_plate_whole_substeps");
+}
+
 // Several modules side by side, with probes on each: the order of the roots, the nesting of
 // their checkpoint records and each probe's module are kept across the restart.
 TEST(Determinism, SeveralModulesInOneScene) {
