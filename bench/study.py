@@ -44,9 +44,11 @@ DEFAULT_COSPH = REPO_ROOT / "build" / "release" / "app" / "cosph"
 # cylinder shedding vortices under acoustic noise;
 # cycle_mean, cycle_amplitude: (max + min) / 2 and (max - min) / 2 of each whole period (the
 # dominant one) in the window, averaged over the periods: Turek & Hron's "mean +- amplitude",
-# which for a signal with harmonics differs from the time mean and the strongest sinusoid.
+# which for a signal with harmonics differs from the time mean and the strongest sinusoid;
+# noise: the standard deviation of a series around its own moving mean (of width `smooth`, which it
+# requires) over the window, e.g. the acoustic noise on a wall pressure's plateau.
 SCALAR_KINDS = ("period", "mean", "maximum", "amplitude", "dominant_period",
-                "dominant_amplitude", "cycle_mean", "cycle_amplitude")
+                "dominant_amplitude", "cycle_mean", "cycle_amplitude", "noise")
 KINDS = ("profile", "time_series", "final") + SCALAR_KINDS
 # Which quantity kinds each norm makes sense for: a spatial L2 needs a profile, an arrival time
 # needs a time series, a relative error at a point needs a single value.
@@ -414,6 +416,9 @@ def _parse_series_options(node: dict, kind: str) -> tuple:
         if not window[0] < window[1]:
             raise StudyError("quantity.window: expected t0 < t1")
     smooth = node.get("smooth")
+    if kind == "noise" and smooth is None:
+        raise StudyError("quantity.smooth: missing (required by kind noise: the width of the "
+                         "moving mean the noise is measured around)")
     if smooth is not None:
         smooth = _number(smooth, "quantity.smooth")
         if not smooth > 0:
@@ -886,7 +891,8 @@ def cycle_statistics(times, series) -> tuple:
 
 def _prepare_series(quantity: Quantity, times, series) -> tuple:
     """The series smoothed by a centred moving average (over the whole record, so the window's
-    edges are averaged with their neighbours), then cut to the window."""
+    edges are averaged with their neighbours), or for kind noise its difference from that
+    average, then cut to the window."""
     if quantity.smooth is not None and len(times) > 2:
         dt = float(np.median(np.diff(times)))
         width = max(1, int(round(quantity.smooth / dt)))
@@ -894,7 +900,8 @@ def _prepare_series(quantity: Quantity, times, series) -> tuple:
         if width > 1:
             kernel = np.ones(width) / width
             padded = np.pad(series, (width // 2, width - 1 - width // 2), mode="edge")
-            series = np.convolve(padded, kernel, mode="valid")
+            smoothed = np.convolve(padded, kernel, mode="valid")
+            series = series - smoothed if quantity.kind == "noise" else smoothed
     if quantity.window is not None:
         inside = (times >= quantity.window[0]) & (times <= quantity.window[1])
         if not inside.any():
@@ -925,6 +932,7 @@ SERIES_VALUES = {
     "dominant_amplitude": lambda q, t, s: dominant_oscillation(t, s)[1],
     "cycle_mean": lambda q, t, s: cycle_statistics(t, s)[0],
     "cycle_amplitude": lambda q, t, s: cycle_statistics(t, s)[1],
+    "noise": lambda q, t, s: float(np.std(s)),
 }
 
 

@@ -9,6 +9,7 @@
 #include "io/csv_time_series.hpp"
 #include "io/probes.hpp"
 #include "io/reductions.hpp"
+#include "io/wall_sensor.hpp"
 
 namespace cosph {
 
@@ -99,6 +100,49 @@ struct ReductionEntry : ProbeSet::Probe {
 };
 
 template <int D>
+struct WallSensorEntry : ProbeSet::Probe {
+  const BodyView<D>* body;
+  WallSensor<D> sensor;
+  WallSensorEntry(const BodyView<D>* b, WallSensor<D> s) : body(b), sensor(std::move(s)) {}
+  std::vector<double> evaluate() const override {
+    return sensor.sample(*body->particles, body->particles->vector("force"),
+                         body->kernel.support_radius());
+  }
+};
+
+template <int D>
+std::unique_ptr<ProbeSet::Probe> make_sensor(const proto::WallSensor& spec, const BodyView<D>* body,
+                                             const std::string& path) {
+  const ParticleSet<D>& particles = *body->particles;
+  if (!particles.has("force") || particles.info("force").kind != FieldKind::Vector ||
+      !particles.has("volume"))
+    throw ConfigError(path + ".body",
+                      "a wall sensor reads the fluid's force on a wall body, and '" +
+                          particles.name() +
+                          "' has none (a fluid's walls with the 'wall_force' "
+                          "output have it)");
+  const Vec<D> normal = to_vec<D>(spec.normal());
+  if (!(normal.norm() > 0.0)) throw ConfigError(path + ".sensor.normal", "the normal is zero");
+  std::vector<Vec<D>> centres;
+  for (const auto& p : spec.at()) centres.push_back(to_vec<D>(p.coordinates()));
+  const Domain<D>& domain = body->domain;
+  for (std::size_t k = 0; k < centres.size(); ++k)
+    for (int a = 0; a < D; ++a)
+      if (domain.upper != domain.lower &&
+          (centres[k][a] < domain.lower[a] || centres[k][a] > domain.upper[a]))
+        throw ConfigError(path + ".sensor.at[" + std::to_string(k) + "]",
+                          "sensor lies outside the domain");
+  auto entry =
+      std::make_unique<WallSensorEntry<D>>(body, WallSensor<D>(centres, normal, spec.diameter()));
+  for (std::size_t k = 0; k < centres.size(); ++k) {
+    std::string column = "pressure@p";  // appended: GCC 12's false -Wrestrict (bug 105329)
+    entry->columns.push_back(column.append(std::to_string(k)));
+    entry->points.emplace_back(centres[k].data(), centres[k].data() + D);
+  }
+  return entry;
+}
+
+template <int D>
 std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const BodyView<D>* body,
                                             const std::string& path) {
   const ParticleSet<D>& particles = *body->particles;
@@ -187,10 +231,12 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
       }
       return entry;
     }
+    case proto::ProbeSpec::kSensor:
+      return make_sensor<D>(spec.sensor(), body, path);
     case proto::ProbeSpec::KIND_NOT_SET:
       break;
   }
-  throw ConfigError(path, "a probe needs one of: points, line, reduce");
+  throw ConfigError(path, "a probe needs one of: points, line, reduce, sensor");
 }
 
 }  // namespace

@@ -37,6 +37,13 @@ struct BoundarySet {
   PairGeometry<D> geometry;
   std::optional<CellLinkedList<D>> cells;  // kept between steps while the set does not move
   bool moves = false;
+  // Per fluid particle, the boundary's unit normal as that particle sees it, pointing into the
+  // boundary: the direction of the gradient of the boundary's kernel-summed volume,
+  // sum_w V_w grad_i W_iw, at the configuration of the advection step (zero where the particle
+  // has no neighbour in the set, or where the sum cancels). Only for an inviscid fluid, whose
+  // Riemann dissipation acts along it: a slip boundary resists the fluid's approach, not its
+  // sliding (seed 003 eq. 14).
+  std::vector<Vec<D>> normal;
 
   // The fluid's force on each boundary particle, recorded pair by pair inside the fluid's own
   // loops (only for sets whose force is asked for: a coupler's contact body, walls with the

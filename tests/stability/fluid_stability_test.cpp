@@ -46,11 +46,13 @@ TEST(FluidStability, DamBreakKeepsEveryParticleInTheTankThroughTheImpact) {
   COSPH_SKIP_CHECKS_IF_REDUCED();  // inside the tank at every step; the density band at the end
   const auto [lo, hi] = std::minmax_element(rho.begin(), rho.end());
   std::cout << "density after 20 time units in [" << *lo << ", " << *hi << "] rho0\n";
-  // Measured [1.00003, 1.00125]: at rest the bottom of the spread layer (0.37 deep) sits at
-  // 1 + g h / c^2 = 1.0009; the band allows 1.5x the measured excess and nothing below rho0's
-  // 1 - 5e-4 (density reinitialisation keeps the free surface at rho0).
+  // Measured [0.9998, 1.00218]: at rest the bottom of the spread layer (0.37 deep) would sit at
+  // 1 + g h / c^2 = 1.0009; with slip walls the water still sloshes at t = 20 (with the wall
+  // friction of the earlier scheme it had settled to 1.00125). The band allows 1.5x the measured
+  // excess and nothing below rho0's 1 - 5e-4 (density reinitialisation keeps the free surface at
+  // rho0).
   EXPECT_GT(*lo, 1.0 - 5e-4);
-  EXPECT_LT(*hi, 1.0 + 1.5 * 0.00125);
+  EXPECT_LT(*hi, 1.0 + 1.5 * 0.00218);
 }
 
 TEST(FluidStability, HydrostaticTankStaysStillForALongRun) {
@@ -91,7 +93,12 @@ TEST(FluidStability, HydrostaticTankStaysStillForALongRun) {
   EXPECT_LT(at_end, 0.8 * after_start);              // decaying: measured 0.646
 }
 
-// The 3D path end to end (coarse, H/10): the surge crosses the tank and stays in it.
+// The 3D path end to end (coarse, H/10): the surge crosses the tank and stays in it. The walls
+// slip (the water is inviscid): the jet that runs up the far wall reaches 2.4 H, and the particles
+// of that thin jet, at nearly zero pressure and so with nearly no repulsion from the wall, slide
+// up with their centres past the wall's face (22-38 of them from t = 3; the farthest 0.13-0.33 of
+// a spacing past it in two builds whose round-off differs). None may reach the first wall layer,
+// half a spacing behind the face.
 TEST(FluidStability, DamBreak3DCrossesTheTankAndStaysInIt) {
   RunOptions options;
   options.bench = true;
@@ -106,7 +113,7 @@ TEST(FluidStability, DamBreak3DCrossesTheTankAndStaysInIt) {
   double front = 0.0;
   for (const auto& x : water.vector("position")) {
     ASSERT_GT(x[0], 0.0);
-    ASSERT_LT(x[0], 5.366);
+    ASSERT_LT(x[0], 5.366 + 0.5 * 0.1);
     ASSERT_GT(x[1], 0.0);
     ASSERT_LT(x[1], 1.0);
     ASSERT_GT(x[2], 0.0);

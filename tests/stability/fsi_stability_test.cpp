@@ -91,9 +91,12 @@ TEST(FsiStability, DamBreakOnAThinElasticPlate) {
   run_to_end("fsi_dambreak_obstacle.yaml", {}, 0.003, 5.65598 / 1.5);
 }
 
-// The coupled 3D path: the 3D dam break hits an elastic plate (water at 2 plate spacings).
+// The coupled 3D path: the 3D dam break hits an elastic plate (water at 2 plate spacings). The
+// water slips along the plate, and the thin sheet that runs up its face sits closer to it than
+// with the wall friction of the earlier scheme (0.941466): measured 0.579457. The bound is what
+// inside means, half a spacing.
 TEST(FsiStability, DamBreakOnAnElasticPlateIn3D) {
-  run_to_end("fsi_dambreak_plate_3d.yaml", {}, 0.05, 0.941466 / 1.5);
+  run_to_end("fsi_dambreak_plate_3d.yaml", {}, 0.05, 0.5);
 }
 
 }  // namespace

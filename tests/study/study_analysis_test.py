@@ -64,6 +64,17 @@ class SeriesPreparation(unittest.TestCase):
         _, smoothed = study._prepare_series(quantity(smooth=0.1, window=(0.2, 0.8)), t, noisy)
         self.assertLess(np.max(np.abs(smoothed)), 0.1)
 
+    def test_noise_is_the_spread_around_the_moving_mean(self):
+        # A slow ramp (left unchanged by a centred mean) plus an alternating +-0.3: the noise is
+        # 0.3 whatever the ramp; a noise kind without a moving-mean width is refused.
+        t = np.arange(0.0, 1.0001, 0.01)
+        signal = 5.0 * t + np.where(np.arange(t.size) % 2 == 0, 0.3, -0.3)
+        q = quantity(kind="noise", smooth=0.2, window=(0.3, 0.7))
+        times, residual = study._prepare_series(q, t, signal)
+        self.assertAlmostEqual(study.SERIES_VALUES["noise"](q, times, residual), 0.3, delta=0.02)
+        with self.assertRaises(study.StudyError):
+            study._parse_series_options({"window": [0, 1]}, "noise")
+
     def test_empty_window_is_an_error(self):
         with self.assertRaises(study.ComparisonError):
             study._prepare_series(quantity(window=(5.0, 6.0)), np.linspace(0, 1, 11),

@@ -1,0 +1,109 @@
+#include "io/wall_sensor.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+#include "core/parallel.hpp"
+
+namespace cosph {
+
+namespace {
+
+// The tangents of a plane with unit normal n: in 3D the coordinate axis least aligned with n,
+// made orthogonal to it, and n x that, so that an axis-aligned wall's squares line up with them.
+template <int D>
+std::vector<Vec<D>> plane_tangents(const Vec<D>& n) {
+  if constexpr (D == 2) {
+    return {Vec<D>(-n[1], n[0])};
+  } else {
+    int k = 0;
+    for (int a = 1; a < D; ++a)
+      if (std::abs(n[a]) < std::abs(n[k])) k = a;
+    Vec<D> t = Vec<D>::Unit(k) - n[k] * n;
+    t.normalize();
+    return {t, n.cross(t)};
+  }
+}
+
+// The face's quadrature points in 3D: the midpoints of a 32 x 32 grid over the disc's bounding
+// square that lie in the disc, as (u, v) in the face's plane.
+std::vector<std::pair<double, double>> disc_points(double radius) {
+  constexpr int m = 32;
+  const double cell = 2.0 * radius / m;
+  std::vector<std::pair<double, double>> points;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double u = -radius + (i + 0.5) * cell, v = -radius + (j + 0.5) * cell;
+      if (u * u + v * v <= radius * radius) points.emplace_back(u, v);
+    }
+  return points;
+}
+
+}  // namespace
+
+template <int D>
+WallSensor<D>::WallSensor(std::vector<Vec<D>> centres, const Vec<D>& normal, double diameter)
+    : centres_(std::move(centres)), radius_(0.5 * diameter) {
+  if (!(normal.norm() > 0.0)) throw std::invalid_argument("wall sensor: the normal is zero");
+  if (!(diameter > 0.0)) throw std::invalid_argument("wall sensor: the diameter must be positive");
+  normal_ = normal.normalized();
+  tangents_ = plane_tangents<D>(normal_);
+  if constexpr (D == 3) face_points_ = disc_points(radius_);
+}
+
+template <int D>
+double WallSensor<D>::face_area() const {
+  return D == 2 ? 2.0 * radius_ : std::acos(-1.0) * radius_ * radius_;
+}
+
+template <int D>
+double WallSensor<D>::covered(const Vec<D>& offset, double a) const {
+  const double half = 0.5 * a;
+  if constexpr (D == 2) {
+    const double s = offset.dot(tangents_[0]);
+    return std::max(0.0, std::min(s + half, radius_) - std::max(s - half, -radius_));
+  } else {
+    const double u = offset.dot(tangents_[0]), v = offset.dot(tangents_[1]);
+    if (std::abs(u) > radius_ + half || std::abs(v) > radius_ + half) return 0.0;
+    // The face's share of quadrature points in the square [u - a/2, u + a/2) x [v - a/2, v + a/2):
+    // half-open, so that a lattice of squares partitions the points exactly.
+    std::size_t inside = 0;
+    for (const auto& [x, y] : face_points_)
+      if (x >= u - half && x < u + half && y >= v - half && y < v + half) ++inside;
+    return face_area() * double(inside) / double(face_points_.size());
+  }
+}
+
+template <int D>
+std::vector<double> WallSensor<D>::sample(const ParticleSet<D>& wall,
+                                          const std::vector<Vec<D>>& force, double depth) const {
+  const auto& x = wall.vector("position");
+  const auto& volume = wall.scalar("volume");
+  std::vector<double> values(centres_.size(), std::numeric_limits<double>::quiet_NaN());
+  parallel_for_each_index(centres_.size(), [&](std::size_t s) {
+    double weighted = 0.0;
+    bool any = false;
+    for (std::size_t w = 0; w < x.size(); ++w) {
+      const Vec<D> r = x[w] - centres_[s];
+      const double behind = -r.dot(normal_);
+      if (!(behind > 0.0 && behind <= depth)) continue;
+      const double a = std::pow(volume[w], 1.0 / D);
+      const double area = covered(r + behind * normal_, a);
+      if (area == 0.0) continue;
+      const double share = D == 2 ? a : a * a;
+      weighted += area * -force[w].dot(normal_) / share;
+      any = true;
+    }
+    if (any) values[s] = weighted / face_area();
+  });
+  return values;
+}
+
+template class WallSensor<2>;
+template class WallSensor<3>;
+
+}  // namespace cosph

@@ -1,0 +1,58 @@
+// Wall pressure sensors: what a transducer flush with a wall measures, the mean pressure over its
+// face, from the force a fluid exerts on the wall particles behind that face.
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "core/particles.hpp"
+#include "core/types.hpp"
+
+namespace cosph {
+
+// Sensors on one flat stretch of wall (one outward normal), each a face of the given diameter
+// centred on a point of the wall's surface: a segment across the normal in 2D, a disc in 3D.
+//
+// Every wall particle w behind the face (at a depth between 0 and `depth` along -normal) owns a
+// share of the wall's surface: the segment (2D) or square (3D) of side a_w = V_w^(1/D) centred on
+// its projection onto the face's plane. The sensor reads
+//   p = sum_w A_w (-F_w . n) / a_w^(D-1) / A,
+// with A_w the area of w's share that the face covers, F_w the force on w and A the face's area
+// (its length in 2D): the pressure on each column of wall particles (the force summed over the
+// column's layers per unit of its share), averaged over the face. It is exact for a uniform
+// pressure whatever the face's size, and a sensor narrower than a particle reads the column in
+// front of it. The face must lie on the wall (a face over a wall's edge reads low), and a sensor
+// that no wall particle covers reads NaN.
+template <int D>
+class WallSensor {
+ public:
+  // Throws std::invalid_argument if the normal is zero or the diameter is not positive.
+  WallSensor(std::vector<Vec<D>> centres, const Vec<D>& normal, double diameter);
+
+  const std::vector<Vec<D>>& centres() const { return centres_; }
+
+  // The pressures, one per sensor, from the wall particles' "position", "volume" and `force`
+  // (all required). `depth` bounds how far behind the face a particle still counts (the fluid's
+  // kernel support: deeper particles get no force, and a far wall must not count).
+  std::vector<double> sample(const ParticleSet<D>& wall, const std::vector<Vec<D>>& force,
+                             double depth) const;
+
+  // The area of a particle's share (side a, centred at `offset` from the face's centre) that the
+  // face covers: exact in 2D; in 3D the share of the face's quadrature points (about 800 over
+  // the disc) that fall in the square, times the face's area, so that the squares of a wall
+  // covering the face add up to exactly its area.
+  double covered(const Vec<D>& offset, double a) const;
+  double face_area() const;  // length in 2D
+
+ private:
+  std::vector<Vec<D>> centres_;
+  Vec<D> normal_;                 // unit, out of the wall
+  std::vector<Vec<D>> tangents_;  // D - 1 unit vectors spanning the face's plane
+  double radius_;
+  std::vector<std::pair<double, double>> face_points_;  // 3D: the face's quadrature points
+};
+
+extern template class WallSensor<2>;
+extern template class WallSensor<3>;
+
+}  // namespace cosph

@@ -1,0 +1,135 @@
+// Wall pressure sensors: the mean pressure over a sensor's face from the force on the wall
+// particles behind it.
+#include "io/wall_sensor.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+#include <vector>
+
+#include "core/particles.hpp"
+
+namespace cosph {
+namespace {
+
+constexpr double kA = 0.1;  // wall particle spacing
+constexpr int kLayers = 3;
+
+// A wall below the plane y = 0 (2D) or z = 0 (3D), kLayers particles thick, over [-1, 1] along the
+// face, plus a far wall above y (z) = 2 facing it. The force on each particle of a column is the
+// column's pressure p(face coordinates) times the particle's share a^(D-1), split unequally over
+// the layers (60/30/10%): the sensor must add the layers, whatever the split.
+template <int D>
+struct Wall {
+  ParticleSet<D> particles{"wall"};
+  std::vector<Vec<D>> force;
+  explicit Wall(const std::function<double(const Vec<D>&)>& pressure) {
+    std::vector<Vec<D>> x;
+    const double split[kLayers] = {0.6, 0.3, 0.1};
+    const int n = static_cast<int>(std::lround(2.0 / kA));
+    const int columns = D == 2 ? n : n * n;
+    for (int c = 0; c < columns; ++c)
+      for (int l = 0; l < kLayers; ++l) {
+        Vec<D> p = Vec<D>::Zero();
+        p[0] = -1.0 + (c % n + 0.5) * kA;
+        if constexpr (D == 3) p[1] = -1.0 + (c / n + 0.5) * kA;
+        p[D - 1] = -(l + 0.5) * kA;
+        const double share = D == 2 ? kA : kA * kA;
+        x.push_back(p);
+        force.push_back(-split[l] * pressure(p) * share * Vec<D>::Unit(D - 1));
+        // The far wall: pushed the other way, and hard; it must not count.
+        Vec<D> q = p;
+        q[D - 1] = 2.0 + (l + 0.5) * kA;
+        x.push_back(q);
+        force.push_back(1e6 * Vec<D>::Unit(D - 1));
+      }
+    particles.resize(x.size());
+    particles.add_vector("position") = x;
+    particles.add_scalar("volume") = std::vector<double>(x.size(), std::pow(kA, D));
+  }
+};
+
+template <int D>
+Vec<D> on_face(double u, double v = 0.0) {
+  Vec<D> c = Vec<D>::Zero();
+  c[0] = u;
+  if constexpr (D == 3) c[1] = v;
+  return c;
+}
+
+template <int D>
+void check_uniform() {
+  const Wall<D> wall([](const Vec<D>&) { return 2.5; });
+  // Faces narrower than a particle, a few particles wide, off the lattice.
+  for (double diameter : {0.03, 0.17, 0.45})
+    for (double u : {0.0, 0.013, 0.35}) {
+      const WallSensor<D> sensor({on_face<D>(u, -0.21)}, Vec<D>::Unit(D - 1), diameter);
+      EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.35)[0], 2.5, 1e-12)
+          << "diameter " << diameter << " at " << u;
+    }
+}
+
+TEST(WallSensor, ReadsAUniformPressureWhateverItsSize2D) { check_uniform<2>(); }
+TEST(WallSensor, ReadsAUniformPressureWhateverItsSize3D) { check_uniform<3>(); }
+
+// A pressure varying along the wall: a face narrower than a particle reads the column in front of
+// it, a wider one the area-weighted mean of the columns it covers.
+TEST(WallSensor, AveragesTheColumnsItsFaceCovers2D) {
+  const Wall<2> wall([](const Vec<2>& x) { return 1.0 + 10.0 * x[0]; });
+  const Vec<2> up = Vec<2>::Unit(1);
+  // Column [0.1, 0.2] carries 1 + 10 * 0.15 = 2.5.
+  EXPECT_NEAR(
+      WallSensor<2>({Vec<2>(0.13, 0.0)}, up, 0.02).sample(wall.particles, wall.force, 0.35)[0], 2.5,
+      1e-12);
+  // Face [0.15, 0.35]: half of column 0.15 (2.5), all of 0.25 (3.5), half of 0.35 (4.5).
+  EXPECT_NEAR(
+      WallSensor<2>({Vec<2>(0.25, 0.0)}, up, 0.2).sample(wall.particles, wall.force, 0.35)[0],
+      (0.05 * 2.5 + 0.1 * 3.5 + 0.05 * 4.5) / 0.2, 1e-12);
+}
+
+// Particles deeper than the depth do not count (nor does the far wall, beyond any depth); with a
+// depth of one layer only the first layer's 60% is read.
+TEST(WallSensor, CountsOnlyTheParticlesBehindTheFaceWithinTheDepth) {
+  const Wall<2> wall([](const Vec<2>&) { return 1.0; });
+  const WallSensor<2> sensor({Vec<2>(0.0, 0.0)}, Vec<2>::Unit(1), 0.3);
+  EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.1)[0], 0.6, 1e-12);
+  EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.35)[0], 1.0, 1e-12);
+}
+
+// The same wall seen from the far side: its normal points the other way, and the near wall's
+// particles lie in front of that face.
+TEST(WallSensor, FacingTheOtherWayReadsTheOtherWall) {
+  const Wall<2> wall([](const Vec<2>&) { return 1.0; });
+  const WallSensor<2> sensor({Vec<2>(0.0, 2.0)}, -Vec<2>::Unit(1), 0.3);
+  // The far wall's force, 1e6 along +y on three layers of share 0.1: 3e7 along the normal's
+  // opposite, i.e. a pressure of 3e7 on the far wall.
+  EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.35)[0], 3e7, 1.0);
+}
+
+TEST(WallSensor, SensorOffTheWallReadsNaNAndBadInputThrows) {
+  const Wall<2> wall([](const Vec<2>&) { return 1.0; });
+  EXPECT_TRUE(std::isnan(WallSensor<2>({Vec<2>(5.0, 0.0)}, Vec<2>::Unit(1), 0.1)
+                             .sample(wall.particles, wall.force, 0.35)[0]));
+  EXPECT_THROW(WallSensor<2>({Vec<2>(0.0, 0.0)}, Vec<2>::Zero(), 0.1), std::invalid_argument);
+  EXPECT_THROW(WallSensor<2>({Vec<2>(0.0, 0.0)}, Vec<2>::Unit(1), 0.0), std::invalid_argument);
+}
+
+// A disc against the squares of a 3D wall: a small disc inside one square is covered whole, a
+// square far away not at all, and the squares of a lattice share a large disc between them
+// exactly.
+TEST(WallSensor, CoveredAreaOfADiscAndASquare3D) {
+  const double pi = std::acos(-1.0);
+  const WallSensor<3> small({Vec<3>::Zero()}, Vec<3>::Unit(2), 0.02);
+  EXPECT_NEAR(small.covered(Vec<3>(0.01, 0.02, 0.0), kA), pi * 0.01 * 0.01, 1e-15);
+  EXPECT_EQ(small.covered(Vec<3>(0.2, 0.0, 0.0), kA), 0.0);
+  const WallSensor<3> large({Vec<3>::Zero()}, Vec<3>::Unit(2), 1.0);
+  double total = 0.0;
+  for (int i = -6; i <= 6; ++i)
+    for (int j = -6; j <= 6; ++j) total += large.covered(Vec<3>(0.03 + i * kA, j * kA, 0.0), kA);
+  EXPECT_NEAR(total, pi * 0.25, 1e-12);
+}
+
+}  // namespace
+}  // namespace cosph
