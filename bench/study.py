@@ -897,6 +897,10 @@ def _prepare_series(quantity: Quantity, times, series) -> tuple:
         dt = float(np.median(np.diff(times)))
         width = max(1, int(round(quantity.smooth / dt)))
         width += 1 - width % 2  # odd, so that the average is centred on each sample
+        if width < 3 and quantity.kind == "noise":
+            raise ComparisonError(f"smooth {quantity.smooth:g} spans fewer than three samples "
+                                  f"(every {dt:g}): the noise around it would be the series' "
+                                  "own spread")
         if width > 1:
             kernel = np.ones(width) / width
             padded = np.pad(series, (width // 2, width - 1 - width // 2), mode="edge")

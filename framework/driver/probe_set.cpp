@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -106,7 +107,7 @@ struct WallSensorEntry : ProbeSet::Probe {
   WallSensorEntry(const BodyView<D>* b, WallSensor<D> s) : body(b), sensor(std::move(s)) {}
   std::vector<double> evaluate() const override {
     return sensor.sample(*body->particles, body->particles->vector("force"),
-                         body->kernel.support_radius());
+                         body->kernel.support_radius(), body->domain);
   }
 };
 
@@ -116,11 +117,10 @@ std::unique_ptr<ProbeSet::Probe> make_sensor(const proto::WallSensor& spec, cons
   const ParticleSet<D>& particles = *body->particles;
   if (!particles.has("force") || particles.info("force").kind != FieldKind::Vector ||
       !particles.has("volume"))
-    throw ConfigError(path + ".body",
-                      "a wall sensor reads the fluid's force on a wall body, and '" +
-                          particles.name() +
-                          "' has none (a fluid's walls with the 'wall_force' "
-                          "output have it)");
+    throw ConfigError(path + ".body", "a wall sensor reads the fluid's force on a wall body ('" +
+                                          particles.name() +
+                                          "' has no vector 'force' and scalar 'volume': a fluid's "
+                                          "walls with the 'wall_force' output have them)");
   const Vec<D> normal = to_vec<D>(spec.normal());
   if (!(normal.norm() > 0.0)) throw ConfigError(path + ".sensor.normal", "the normal is zero");
   std::vector<Vec<D>> centres;
@@ -132,8 +132,22 @@ std::unique_ptr<ProbeSet::Probe> make_sensor(const proto::WallSensor& spec, cons
           (centres[k][a] < domain.lower[a] || centres[k][a] > domain.upper[a]))
         throw ConfigError(path + ".sensor.at[" + std::to_string(k) + "]",
                           "sensor lies outside the domain");
-  auto entry =
-      std::make_unique<WallSensorEntry<D>>(body, WallSensor<D>(centres, normal, spec.diameter()));
+  std::unique_ptr<WallSensorEntry<D>> entry;
+  try {
+    entry =
+        std::make_unique<WallSensorEntry<D>>(body, WallSensor<D>(centres, normal, spec.diameter()));
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(path + ".sensor", e.what());
+  }
+  const auto covered =
+      entry->sensor.covered_by(particles, body->kernel.support_radius(), body->domain);
+  for (std::size_t k = 0; k < covered.size(); ++k)
+    if (!covered[k])
+      throw ConfigError(path + ".sensor.at[" + std::to_string(k) + "]",
+                        "no wall particle of '" + particles.name() +
+                            "' lies behind this sensor's face (within the kernel's support along "
+                            "minus the normal): is it on the wall's surface, and does 'normal' "
+                            "point out of the wall into the fluid?");
   for (std::size_t k = 0; k < centres.size(); ++k) {
     std::string column = "pressure@p";  // appended: GCC 12's false -Wrestrict (bug 105329)
     entry->columns.push_back(column.append(std::to_string(k)));

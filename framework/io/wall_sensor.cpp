@@ -49,7 +49,8 @@ template <int D>
 WallSensor<D>::WallSensor(std::vector<Vec<D>> centres, const Vec<D>& normal, double diameter)
     : centres_(std::move(centres)), radius_(0.5 * diameter) {
   if (!(normal.norm() > 0.0)) throw std::invalid_argument("wall sensor: the normal is zero");
-  if (!(diameter > 0.0)) throw std::invalid_argument("wall sensor: the diameter must be positive");
+  if (!(diameter > 0.0 && std::isfinite(diameter)))
+    throw std::invalid_argument("wall sensor: the diameter must be positive and finite");
   normal_ = normal.normalized();
   tangents_ = plane_tangents<D>(normal_);
   if constexpr (D == 3) face_points_ = disc_points(radius_);
@@ -79,28 +80,46 @@ double WallSensor<D>::covered(const Vec<D>& offset, double a) const {
 }
 
 template <int D>
-std::vector<double> WallSensor<D>::sample(const ParticleSet<D>& wall,
-                                          const std::vector<Vec<D>>& force, double depth) const {
+template <typename F>
+void WallSensor<D>::for_each_covered(const ParticleSet<D>& wall, double depth,
+                                     const Domain<D>& domain, std::size_t s, const F& f) const {
   const auto& x = wall.vector("position");
   const auto& volume = wall.scalar("volume");
+  for (std::size_t w = 0; w < x.size(); ++w) {
+    const Vec<D> r = domain.displacement(x[w], centres_[s]);  // x_w - centre, minimum image
+    const double behind = -r.dot(normal_);
+    if (!(behind > 0.0 && behind <= depth)) continue;
+    const double a = std::pow(volume[w], 1.0 / D);
+    const double area = covered(r + behind * normal_, a);
+    if (area > 0.0) f(w, area, D == 2 ? a : a * a);
+  }
+}
+
+template <int D>
+std::vector<double> WallSensor<D>::sample(const ParticleSet<D>& wall,
+                                          const std::vector<Vec<D>>& force, double depth,
+                                          const Domain<D>& domain) const {
   std::vector<double> values(centres_.size(), std::numeric_limits<double>::quiet_NaN());
   parallel_for_each_index(centres_.size(), [&](std::size_t s) {
     double weighted = 0.0;
     bool any = false;
-    for (std::size_t w = 0; w < x.size(); ++w) {
-      const Vec<D> r = x[w] - centres_[s];
-      const double behind = -r.dot(normal_);
-      if (!(behind > 0.0 && behind <= depth)) continue;
-      const double a = std::pow(volume[w], 1.0 / D);
-      const double area = covered(r + behind * normal_, a);
-      if (area == 0.0) continue;
-      const double share = D == 2 ? a : a * a;
+    for_each_covered(wall, depth, domain, s, [&](std::size_t w, double area, double share) {
       weighted += area * -force[w].dot(normal_) / share;
       any = true;
-    }
+    });
     if (any) values[s] = weighted / face_area();
   });
   return values;
+}
+
+template <int D>
+std::vector<bool> WallSensor<D>::covered_by(const ParticleSet<D>& wall, double depth,
+                                            const Domain<D>& domain) const {
+  std::vector<bool> covered(centres_.size(), false);
+  for (std::size_t s = 0; s < centres_.size(); ++s)
+    for_each_covered(wall, depth, domain, s,
+                     [&](std::size_t, double, double) { covered[s] = true; });
+  return covered;
 }
 
 template class WallSensor<2>;

@@ -7,6 +7,7 @@
 
 #include "core/particles.hpp"
 #include "core/types.hpp"
+#include "neighbour/domain.hpp"
 
 namespace cosph {
 
@@ -26,16 +27,20 @@ namespace cosph {
 template <int D>
 class WallSensor {
  public:
-  // Throws std::invalid_argument if the normal is zero or the diameter is not positive.
+  // Throws std::invalid_argument if the normal is zero or the diameter is not positive or finite.
   WallSensor(std::vector<Vec<D>> centres, const Vec<D>& normal, double diameter);
 
   const std::vector<Vec<D>>& centres() const { return centres_; }
 
   // The pressures, one per sensor, from the wall particles' "position", "volume" and `force`
   // (all required). `depth` bounds how far behind the face a particle still counts (the fluid's
-  // kernel support: deeper particles get no force, and a far wall must not count).
+  // kernel support: deeper particles get no force, and a far wall must not count). Offsets are
+  // minimum images on the domain's periodic axes.
   std::vector<double> sample(const ParticleSet<D>& wall, const std::vector<Vec<D>>& force,
-                             double depth) const;
+                             double depth, const Domain<D>& domain = {}) const;
+  // Whether any wall particle lies behind each sensor's face (what sample() needs to read it).
+  std::vector<bool> covered_by(const ParticleSet<D>& wall, double depth,
+                               const Domain<D>& domain = {}) const;
 
   // The area of a particle's share (side a, centred at `offset` from the face's centre) that the
   // face covers: exact in 2D; in 3D the share of the face's quadrature points (about 800 over
@@ -45,6 +50,11 @@ class WallSensor {
   double face_area() const;  // length in 2D
 
  private:
+  // Calls f(w, covered area, share area) for every wall particle w behind sensor s's face.
+  template <typename F>
+  void for_each_covered(const ParticleSet<D>& wall, double depth, const Domain<D>& domain,
+                        std::size_t s, const F& f) const;
+
   std::vector<Vec<D>> centres_;
   Vec<D> normal_;                 // unit, out of the wall
   std::vector<Vec<D>> tangents_;  // D - 1 unit vectors spanning the face's plane

@@ -118,17 +118,28 @@ TEST(WallSensor, SensorOffTheWallReadsNaNAndBadInputThrows) {
 
 // A disc against the squares of a 3D wall: a small disc inside one square is covered whole, a
 // square far away not at all, and the squares of a lattice share a large disc between them
-// exactly.
+// exactly. The squares' edges (side 1/8, centres k/8 + 5/64) fall on the face's quadrature points
+// ((2 i + 1) / 64 - 1/2 for a unit disc), so a point on an edge must count once, not twice.
 TEST(WallSensor, CoveredAreaOfADiscAndASquare3D) {
   const double pi = std::acos(-1.0);
   const WallSensor<3> small({Vec<3>::Zero()}, Vec<3>::Unit(2), 0.02);
   EXPECT_NEAR(small.covered(Vec<3>(0.01, 0.02, 0.0), kA), pi * 0.01 * 0.01, 1e-15);
   EXPECT_EQ(small.covered(Vec<3>(0.2, 0.0, 0.0), kA), 0.0);
   const WallSensor<3> large({Vec<3>::Zero()}, Vec<3>::Unit(2), 1.0);
+  const double side = 0.125, shift = 5.0 / 64.0;
   double total = 0.0;
   for (int i = -6; i <= 6; ++i)
-    for (int j = -6; j <= 6; ++j) total += large.covered(Vec<3>(0.03 + i * kA, j * kA, 0.0), kA);
+    for (int j = -6; j <= 6; ++j)
+      total += large.covered(Vec<3>(shift + i * side, shift + j * side, 0.0), side);
   EXPECT_NEAR(total, pi * 0.25, 1e-12);
+}
+
+// A 3D pressure varying over the wall, p = 1 + 10 x + 3 y: a face narrower than a particle reads
+// the column in front of it (x in [0.1, 0.2], y in [-0.3, -0.2]: 1.75).
+TEST(WallSensor, ReadsTheColumnInFrontOfASmallFace3D) {
+  const Wall<3> wall([](const Vec<3>& x) { return 1.0 + 10.0 * x[0] + 3.0 * x[1]; });
+  const WallSensor<3> sensor({Vec<3>(0.13, -0.21, 0.0)}, Vec<3>::Unit(2), 0.02);
+  EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.35)[0], 1.75, 1e-12);
 }
 
 }  // namespace

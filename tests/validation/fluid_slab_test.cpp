@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../support/probe_csv.hpp"
@@ -66,12 +67,16 @@ TEST(FluidSlab, DamBreakAsAPeriodicSlabReproducesThe2DFrontAndWallPressure) {
   const DamBreakRun slab = run("fluid_dambreak_3d_slab.yaml",
                                {"output.vtp=false", "checkpoint.at_end=false"}, "cosph_slab_3d", 2);
   COSPH_SKIP_CHECKS_IF_REDUCED();
-  // Measured front differences 0.0012, 0.0006, 0.0023, 0.0075 H at t = 0.5, 1, 1.5, 2.
-  for (double t : {0.5, 1.0, 1.5, 2.0}) {
+  // Measured front differences 0.0012, 0.0006, 0.0023, 0.0075 H at t = 0.5, 1, 1.5, 2; each
+  // bounded at 1.5x, but not below 0.004 H (a twelfth of the spacing: round-off changes move the
+  // front by a few thousandths).
+  const std::pair<double, double> fronts[] = {
+      {0.5, 0.004}, {1.0, 0.004}, {1.5, 0.004}, {2.0, 1.5 * 0.0075}};
+  for (const auto& [t, bound] : fronts) {
     const double a = value_at(flat.front_t, flat.front, t),
                  b = value_at(slab.front_t, slab.front, t);
     std::cout << "front at t = " << t << ": 2D " << a << ", slab " << b << "\n";
-    EXPECT_NEAR(b, a, 1.5 * 0.0075) << "front at t = " << t;
+    EXPECT_NEAR(b, a, bound) << "front at t = " << t;
   }
   const auto& t2 = flat.sensor_t;
   const auto& t3 = slab.sensor_t;
@@ -88,7 +93,7 @@ TEST(FluidSlab, DamBreakAsAPeriodicSlabReproducesThe2DFrontAndWallPressure) {
   // sensor 1 (the slab lower: sensor 1's face lies within a kernel support of the floor, where the
   // 3D kernel spreads the load differently), 0.778 and 0.725-0.750 at sensor 3 (the ranges: two
   // builds whose round-off differs; the splashing plateau is chaotic).
-  EXPECT_NEAR(impact_3d, impact_2d, 0.02);
+  EXPECT_NEAR(impact_3d, impact_2d, 0.02);  // two samples
   EXPECT_NEAR(plateau_3d, plateau_2d, 1.5 * 0.108);
   EXPECT_NEAR(plateau3_3d, plateau3_2d, 1.5 * 0.053);
 }
