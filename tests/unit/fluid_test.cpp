@@ -265,6 +265,17 @@ const std::string kTankWallForces = std::string(kTank) + R"yaml(  - name: all_wa
 const std::vector<std::string> kWallForceOutput = {"modules[0].fluid.outputs=[wall_force]",
                                                    "end_time=1", "output.vtp=false"};
 
+// The mean of a probe's column over its rows from time `from` on (past the acoustic start-up).
+double mean_from(const std::string& directory, const std::string& probe, int column, double from) {
+  const auto t = test::csv_column(directory + "/" + probe + ".csv", 0);
+  const auto f = test::csv_column(directory + "/" + probe + ".csv", column);
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] >= from) sum += f[k], ++n;
+  return sum / n;
+}
+
 TEST(Fluid, TankWallsCarryTheWeightAndTheHydrostaticThrust) {
   RunOptions options;
   options.output_directory =
@@ -272,17 +283,9 @@ TEST(Fluid, TankWallsCarryTheWeightAndTheHydrostaticThrust) {
   auto simulation = make_simulation(kTankWallForces, kWallForceOutput, options);
   simulation->run();
   auto mean = [&](const std::string& probe, int column) {
-    const auto t = test::csv_column(options.output_directory + "/" + probe + ".csv", 0);
-    const auto f = test::csv_column(options.output_directory + "/" + probe + ".csv", column);
-    double sum = 0.0;
-    int n = 0;
-    for (std::size_t k = 0; k < t.size(); ++k)
-      if (t[k] >= 0.5) {
-        sum += f[k];
-        ++n;
-      }
-    return sum / n;
+    return mean_from(options.output_directory, probe, column, 0.5);
   };
+
   const double fx = mean("all_walls", 1), fy = mean("all_walls", 2);
   const double thrust = mean("left_wall", 1);
   std::cout << "mean force on the walls (" << fx << ", " << fy << "), weight 9810; on the left "
@@ -314,14 +317,9 @@ TEST(Fluid, WallSensorsReadTheHydrostaticPressure) {
   auto simulation = make_simulation(kTankSensors, kWallForceOutput, options);
   simulation->run();
   auto mean = [&](const std::string& probe, int column) {
-    const auto t = test::csv_column(options.output_directory + "/" + probe + ".csv", 0);
-    const auto p = test::csv_column(options.output_directory + "/" + probe + ".csv", column);
-    double sum = 0.0;
-    int n = 0;
-    for (std::size_t k = 0; k < t.size(); ++k)
-      if (t[k] >= 0.5) sum += p[k], ++n;
-    return sum / n;
+    return mean_from(options.output_directory, probe, column, 0.5);
   };
+
   const double floor = mean("floor_sensor", 1);
   std::cout << "floor " << floor << " (9810)";
   const double heights[] = {0.25, 0.5, 0.75};
