@@ -44,6 +44,11 @@ struct BoundarySet {
   // Riemann dissipation acts along it: a slip boundary resists the fluid's approach, not its
   // sliding (seed 003 eq. 14).
   std::vector<Vec<D>> normal;
+  // Per boundary particle, its own unit normal into the boundary: the direction of the gradient of
+  // the set's kernel-summed volume at the particle (zero deep inside, where the sum is flat).
+  // Only for walls (a body's one-layer contact surface has no volume gradient across it), and
+  // only for an inviscid fluid; rebuilt with the set's cell list.
+  std::vector<Vec<D>> own_normal;
 
   // The fluid's force on each boundary particle, recorded pair by pair inside the fluid's own
   // loops (only for sets whose force is asked for: a coupler's contact body, walls with the

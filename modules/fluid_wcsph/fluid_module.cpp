@@ -486,6 +486,29 @@ class FluidModule final : public Module {
                                         : MomentumDissipation::limited};
   }
 
+  // At a slip wall with its own normals the Riemann pressure is the one-sided problem's acoustic
+  // solution, P* = (p_i + p_w) / 2 + rho0 c (v_i - v_w) . n_w (Joukowsky's water hammer): the
+  // low-dissipation limiter removes the velocity-jump term between fluid particles because there
+  // it acts on shear too, but along the wall's normal there is no shear for it to damp. A scene
+  // without momentum dissipation keeps none at its walls.
+  RiemannSolver slip_wall_riemann() const {
+    return {spec_.density() * sound_speed_, sound_speed_,
+            spec_.riemann_solver() == "continuity_only" ? MomentumDissipation::none
+                                                        : MomentumDissipation::acoustic};
+  }
+
+  // A slip wall pair's Riemann pressure as a vector (the pair's force on i is -2 V_i V_w |dW|
+  // times it): the mean pressure along e_iw, and the acoustic dissipation of the velocity jump
+  // along the wall particle's own normal n_w, along n_w weighted by max(e_iw . n_w, 0) (a flat
+  // wall's pairs then sum to its normal whatever the fluid particle's place along the wall
+  // lattice; a pair behind n_w would be anti-dissipative).
+  static Vec<D> own_normal_pressure(const RiemannSolver& acoustic, const Vec<D>& n, const Vec<D>& e,
+                                    double p_i, const Vec<D>& v_i, const OneSidedState<D>& wall) {
+    const double mean = 0.5 * (p_i + wall.pressure);
+    const double P = acoustic.pressure(p_i, wall.pressure, v_i.dot(n), wall.velocity.dot(n));
+    return mean * e + ((P - mean) * std::max(e.dot(n), 0.0)) * n;
+  }
+
   void sort_by_cell() {
     const auto order =
         cell_sort_order<D>(fluid_.vector("position"), kernel_.support_radius(), domain_);
@@ -601,10 +624,13 @@ class FluidModule final : public Module {
       if (b->empty()) continue;
       const auto& bx = b->particles.vector("position");
       // Static walls keep their cell list; moving walls and contact bodies rebuild it.
-      if (!b->cells || b->moves) b->cells.emplace(bx, kernel_.support_radius(), domain_);
+      if (!b->cells || b->moves) {
+        b->cells.emplace(bx, kernel_.support_radius(), domain_);
+        if (b == &walls_ && slip_walls()) own_normals(*b);
+      }
       b->list = build_contact_list<D>(x, *b->cells, kernel_.support_radius());
       pair_geometry(x, bx, b->list, b->geometry);
-      if (slip_walls()) boundary_normals(*b);
+      if (slip_walls() && b->own_normal.empty()) boundary_normals(*b);
       if (b->records) {
         build_pairs_of(*b);
         b->pair_pressure_force.assign(b->list.pair_count(), Vec<D>::Zero());
@@ -622,6 +648,25 @@ class FluidModule final : public Module {
   // friction on top of the viscous term's (it resolves the boundary layer of the Re = 100 cylinder
   // at D/20: lift amplitude 5% off the benchmark with it, 23% with the normal jump alone).
   bool slip_walls() const { return !(spec_.viscosity() > 0.0); }
+
+  // BoundarySet::own_normal: sum_w' V_w' (-dW/dr) e_ww' over the set's own particles, normalised.
+  void own_normals(BoundarySet<D>& b) const {
+    const auto& x = b.particles.vector("position");
+    const auto& V = b.particles.scalar("volume");
+    const NeighbourList list = build_inner_list<D>(x, kernel_.support_radius(), domain_);
+    b.own_normal.assign(x.size(), Vec<D>::Zero());
+    parallel_for_each_index(x.size(), [&](std::size_t w) {
+      Vec<D> g = Vec<D>::Zero();
+      for (std::size_t k = list.offset[w]; k < list.offset[w + 1]; ++k) {
+        const Vec<D> d = domain_.displacement(x[list.index[k]], x[w]);
+        const double r = d.norm();
+        if (r > 0.0) g += (V[list.index[k]] * -kernel_.derivative(r) / r) * d;
+      }
+      // Relative to one particle's own gradient scale: deep inside the sum is flat (round-off).
+      const double scale = V[w] * -kernel_.derivative(0.5 * kernel_.support_radius()) + 1e-300;
+      b.own_normal[w] = g.norm() > 1e-9 * scale ? Vec<D>(g.normalized()) : Vec<D>(Vec<D>::Zero());
+    });
+  }
 
   // BoundarySet::normal from the pair geometry just built: sum_w V_w (-dW/dr) e_iw, normalised.
   void boundary_normals(BoundarySet<D>& b) const {
@@ -911,6 +956,7 @@ class FluidModule final : public Module {
     const auto sets = boundaries();
     const auto views = boundary_views(sets);
     const bool slip = slip_walls();
+    const RiemannSolver acoustic = slip_wall_riemann();
     dv_.resize(x.size());
     parallel_for_each_index(x.size(), [&](std::size_t i) {
       Vec<D> sum = Vec<D>::Zero();
@@ -920,23 +966,28 @@ class FluidModule final : public Module {
         const double P = solver.pressure(p[i], p[j], v[i].dot(e), v[j].dot(e));
         sum -= (volume[j] * P * inner_geometry_.gradient[k]) * e;
       }
-      for_each_boundary_neighbour(i, x[i], p[i], rho[i], v[i], sets, views,
-                                  [&](const Vec<D>& e, double gradient, double V, const auto& wall,
-                                      BoundarySet<D>& b, std::size_t k) {
-                                    // Slip: the velocity jump along the boundary's normal
-                                    // (slip_walls), the same for every pair of i; their forces
-                                    // along e_iw sum to the normal, and the reaction stays
-                                    // pairwise.
-                                    const Vec<D>& n = slip ? b.normal[i] : e;
-                                    const double P = solver.pressure(
-                                        p[i], wall.pressure, v[i].dot(n), wall.velocity.dot(n));
-                                    sum -= (V * P * gradient) * e;
-                                    // Its reaction on the boundary: m_i dv_i = -2 V_i V_w P* |dW|
-                                    // e_iw.
-                                    if (b.records)
-                                      b.pair_pressure_force[k] =
-                                          (2.0 * volume[i] * V * P * gradient) * e;
-                                  });
+      for_each_boundary_neighbour(
+          i, x[i], p[i], rho[i], v[i], sets, views,
+          [&](const Vec<D>& e, double gradient, double V, const auto& wall, BoundarySet<D>& b,
+              std::size_t k) {
+            if (slip && !b.own_normal.empty()) {
+              const Vec<D> P =
+                  own_normal_pressure(acoustic, b.own_normal[b.list.index[k]], e, p[i], v[i], wall);
+              sum -= (V * gradient) * P;
+              if (b.records) b.pair_pressure_force[k] = (2.0 * volume[i] * V * gradient) * P;
+              return;
+            }
+            // No-slip: the mirrored velocity along e_iw. Slip at a contact
+            // body: the jump along the normal as i sees it, the same for
+            // all of i's pairs; the reaction stays pairwise.
+            const Vec<D>& n = slip ? b.normal[i] : e;
+            const double P =
+                solver.pressure(p[i], wall.pressure, v[i].dot(n), wall.velocity.dot(n));
+            sum -= (V * P * gradient) * e;
+            // Its reaction on the boundary: m_i dv_i = -2 V_i V_w P* |dW|
+            // e_iw.
+            if (b.records) b.pair_pressure_force[k] = (2.0 * volume[i] * V * P * gradient) * e;
+          });
       dv_[i] = (2.0 / rho[i]) * sum;
     });
     parallel_stream(x.size(), [&](std::size_t i) { v[i] += dt * (dv_[i] + prior[i]); });

@@ -46,13 +46,13 @@ TEST(FluidStability, DamBreakKeepsEveryParticleInTheTankThroughTheImpact) {
   COSPH_SKIP_CHECKS_IF_REDUCED();  // inside the tank at every step; the density band at the end
   const auto [lo, hi] = std::minmax_element(rho.begin(), rho.end());
   std::cout << "density after 20 time units in [" << *lo << ", " << *hi << "] rho0\n";
-  // Measured [0.9998, 1.00218]: at rest the bottom of the spread layer (0.37 deep) would sit at
-  // 1 + g h / c^2 = 1.0009; with slip walls the water still sloshes at t = 20 (with the wall
-  // friction of the earlier scheme it had settled to [1.00003, 1.00125]). The band allows 1.5x
-  // the measured excess above rho0 and 2.5x the deficit below it (reinitialisation keeps the free
-  // surface near rho0, at most 2e-4 below it in this run).
-  EXPECT_GT(*lo, 1.0 - 5e-4);
-  EXPECT_LT(*hi, 1.0 + 1.5 * 0.00218);
+  // Measured [0.999704, 1.00118]: at rest the bottom of the spread layer (0.37 deep) would sit at
+  // 1 + g h / c^2 = 1.0009 (with the dissipation along the normal as each fluid particle sees it
+  // the water still sloshed at t = 20, [0.9998, 1.00218]; with the wall friction of the earlier
+  // scheme it had settled to [1.00003, 1.00125]). The band allows 1.5x the measured excess above
+  // rho0 and the deficit below it (reinitialisation keeps the free surface near rho0).
+  EXPECT_GT(*lo, 1.0 - 1.5 * 0.000296);
+  EXPECT_LT(*hi, 1.0 + 1.5 * 0.00118);
 }
 
 TEST(FluidStability, HydrostaticTankStaysStillForALongRun) {
@@ -88,17 +88,19 @@ TEST(FluidStability, HydrostaticTankStaysStillForALongRun) {
   std::cout << "after 20 s: largest speed " << speed << " m/s (sqrt(g H) = 3.13), kinetic energy "
             << kinetic / potential << " of the potential energy; mean over t = 1.5-3.5 "
             << after_start / potential << ", over t = 18-20 " << at_end / potential << "\n";
-  EXPECT_LT(speed, 1.5 * 0.0567 * std::sqrt(9.81));  // measured 5.67%
-  EXPECT_LT(kinetic, 1.5 * 2.69e-4 * potential);     // measured 2.69e-4
-  EXPECT_LT(at_end, 0.8 * after_start);              // decaying: measured 0.646
+  EXPECT_LT(speed, 1.5 * 0.0403 * std::sqrt(9.81));  // measured 4.03%
+  EXPECT_LT(kinetic, 1.5 * 9.49e-5 * potential);     // measured 9.49e-5
+  // Decaying: measured 0.797 (0.646 with the dissipation along the normal as each fluid particle
+  // sees it, whose start-up motion was larger: the walls' own normals damp it from the start).
+  EXPECT_LT(at_end, 0.9 * after_start);
 }
 
 // The 3D path end to end (coarse, H/10): the surge crosses the tank and stays in it. The walls
-// slip (the water is inviscid): the jet that runs up the far wall reaches 2.4 H, and the particles
-// of that thin jet, at nearly zero pressure and so with nearly no repulsion from the wall, slide
-// up with their centres past the wall's face (22-38 of them from t = 3; the farthest 0.13-0.33 of
-// a spacing past it in two builds whose round-off differs). None may reach the first wall layer,
-// half a spacing behind the face.
+// slip (the water is inviscid): the jet that runs up the far wall reaches 2.4 H. With the walls'
+// acoustic dissipation along their own normals no particle's centre passes the wall's face (the
+// farthest at t = 4 is at 5.348, 0.18 spacings inside it); with the dissipation along the normal as
+// each fluid particle sees it, the thin jet's particles, at nearly zero pressure, slid up with
+// their centres up to 0.33 of a spacing past it.
 TEST(FluidStability, DamBreak3DCrossesTheTankAndStaysInIt) {
   RunOptions options;
   options.bench = true;
@@ -113,7 +115,7 @@ TEST(FluidStability, DamBreak3DCrossesTheTankAndStaysInIt) {
   double front = 0.0;
   for (const auto& x : water.vector("position")) {
     ASSERT_GT(x[0], 0.0);
-    ASSERT_LT(x[0], 5.366 + 0.5 * 0.1);
+    ASSERT_LT(x[0], 5.366);
     ASSERT_GT(x[1], 0.0);
     ASSERT_LT(x[1], 1.0);
     ASSERT_GT(x[2], 0.0);
@@ -121,7 +123,7 @@ TEST(FluidStability, DamBreak3DCrossesTheTankAndStaysInIt) {
   }
   COSPH_SKIP_CHECKS_IF_REDUCED();
   std::cout << "3D surge front at t = 4: " << front << " H\n";
-  EXPECT_GT(front, 4.5);  // measured 5.30: the water reached the far wall
+  EXPECT_GT(front, 4.5);  // measured 5.348: the water reached the far wall
 }
 
 }  // namespace

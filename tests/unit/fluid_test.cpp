@@ -233,20 +233,47 @@ probes:
     reduce: {quantity: kinetic_energy}
 )yaml";
 
+// The mean of a probe's column over its rows from time `from` on (past the acoustic start-up).
+double mean_from(const std::string& directory, const std::string& probe, int column, double from) {
+  const auto t = test::csv_column(directory + "/" + probe + ".csv", 0);
+  const auto f = test::csv_column(directory + "/" + probe + ".csv", column);
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] >= from) sum += f[k], ++n;
+  return sum / n;
+}
+
 TEST(Fluid, HydrostaticTankHoldsRhoGHAndStaysStill) {
-  auto simulation = make_simulation(kTank, {});
+  RunOptions options;
+  options.output_directory =
+      (std::filesystem::path(testing::TempDir()) / "cosph_fluid_tank").string();
+  auto simulation = make_simulation(kTank, {"output.vtp=false"}, options);
   const RunSummary summary = simulation->run();  // the health monitor checks the density band
-  const double bottom = summary.probes.at("bottom").at("pressure@p0");
-  const double middle = summary.probes.at("bottom").at("pressure@p1");
+  // The water rings acoustically (period 4 H / c = 0.09, mid-depth standard deviation ~300 Pa):
+  // one instant is a sample of that noise, so the pressures are time means past the start-up.
+  const double bottom = mean_from(options.output_directory, "bottom", 1, 0.5);
+  const double middle = mean_from(options.output_directory, "bottom", 2, 0.5);
   const double kinetic = summary.probes.at("kinetic_energy").at("kinetic_energy");
   const double potential = 1000.0 * 9.81 * 1.0 * 0.5;  // rho g H^2 W / 2 per unit depth
-  std::cout << "bottom pressure " << bottom << " (rho g H = 9810), mid-depth " << middle
+  std::cout << "mean bottom pressure " << bottom << " (rho g H = 9810), mid-depth " << middle
             << " (4905), kinetic energy " << kinetic << " J (" << kinetic / potential
             << " of the potential energy)\n";
-  // Measured at dp = H/20: bottom (linear extrapolation to the wall) 9,143 (-6.8%), mid-depth
-  // 5,064 (+3.2%); at H/40 the bottom reads 9,975.
-  EXPECT_NEAR(bottom, 9810.0, 0.1 * 9810.0);
-  EXPECT_NEAR(middle, 4905.0, 0.05 * 4905.0);
+  // Measured at dp = H/20 over t = 0.5-2: bottom (linear extrapolation to the wall) 10,112
+  // (+3.1%), mid-depth 5,034 (+2.6%).
+  EXPECT_NEAR(bottom, 9810.0, 1.5 * 0.031 * 9810.0);
+  EXPECT_NEAR(middle, 4905.0, 1.5 * 0.026 * 4905.0);
+  // The walls' acoustic dissipation along their normals damps the ringing: the mid-depth
+  // pressure's standard deviation over t = 0.5-2 is 174 Pa (563 Pa with the dissipation along
+  // the normal as each fluid particle sees it, which the wall lattice's roughness tilts).
+  const auto t = test::csv_column(options.output_directory + "/bottom.csv", 0);
+  const auto p = test::csv_column(options.output_directory + "/bottom.csv", 2);
+  double square = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (t[k] >= 0.5) square += (p[k] - middle) * (p[k] - middle), ++n;
+  std::cout << "mid-depth pressure standard deviation " << std::sqrt(square / n) << " Pa\n";
+  EXPECT_LT(std::sqrt(square / n), 1.5 * 174.0);
   EXPECT_LT(kinetic, 1e-3 * potential);
 }
 
@@ -265,17 +292,6 @@ const std::string kTankWallForces = std::string(kTank) + R"yaml(  - name: all_wa
 const std::vector<std::string> kWallForceOutput = {"modules[0].fluid.outputs=[wall_force]",
                                                    "end_time=1", "output.vtp=false"};
 
-// The mean of a probe's column over its rows from time `from` on (past the acoustic start-up).
-double mean_from(const std::string& directory, const std::string& probe, int column, double from) {
-  const auto t = test::csv_column(directory + "/" + probe + ".csv", 0);
-  const auto f = test::csv_column(directory + "/" + probe + ".csv", column);
-  double sum = 0.0;
-  int n = 0;
-  for (std::size_t k = 0; k < t.size(); ++k)
-    if (t[k] >= from) sum += f[k], ++n;
-  return sum / n;
-}
-
 TEST(Fluid, TankWallsCarryTheWeightAndTheHydrostaticThrust) {
   RunOptions options;
   options.output_directory =
@@ -290,11 +306,12 @@ TEST(Fluid, TankWallsCarryTheWeightAndTheHydrostaticThrust) {
   const double thrust = mean("left_wall", 1);
   std::cout << "mean force on the walls (" << fx << ", " << fy << "), weight 9810; on the left "
             << "wall " << thrust << ", thrust 4905\n";
-  // Measured -9,701 and -4,851 (1.1% low): the water is not quite at rest at H/20 (its kinetic
-  // energy is ~1e-3 of the potential), so its momentum still changes a little.
-  EXPECT_NEAR(fy, -9810.0, 0.02 * 9810.0);
+  // Measured -9,785 and -4,886 (0.25% and 0.40% low): the water is not quite at rest at H/20,
+  // so its momentum still changes a little (1.1% low with the dissipation along the normal as
+  // each fluid particle sees it, under which the tank rang three times louder).
+  EXPECT_NEAR(fy, -9810.0, 1.5 * 0.0025 * 9810.0);
   EXPECT_NEAR(fx, 0.0, 0.001 * 9810.0);  // symmetric tank
-  EXPECT_NEAR(thrust, -4905.0, 0.03 * 4905.0);
+  EXPECT_NEAR(thrust, -4905.0, 1.5 * 0.0040 * 4905.0);
 }
 
 // The same tank's walls read by wall sensors (the mean pressure over a face from the force on the
@@ -323,9 +340,10 @@ TEST(Fluid, WallSensorsReadTheHydrostaticPressure) {
   const double floor = mean("floor_sensor", 1);
   std::cout << "floor " << floor << " (9810)";
   const double heights[] = {0.25, 0.5, 0.75};
-  // Measured at H/20: -1.72%, -1.21%, -1.91% on the side wall, -2.79% on the floor (the water
-  // still rings a little, and the hydrostatic tank reads its bottom 1.1% low in total).
-  const double bounds[] = {1.5 * 0.0172, 1.5 * 0.0121, 1.5 * 0.0191};
+  // Measured at H/20: -0.71%, -0.55%, -0.61% on the side wall, -0.32% on the floor (the water
+  // still rings a little; -1.72%, -1.21%, -1.91% and -2.79% with the dissipation along the normal
+  // as each fluid particle sees it).
+  const double bounds[] = {1.5 * 0.0071, 1.5 * 0.0055, 1.5 * 0.0061};
   for (int k = 0; k < 3; ++k) {
     const double expected = 1000.0 * 9.81 * (1.0 - heights[k]);
     const double side = mean("sensors", k + 1);
@@ -333,7 +351,7 @@ TEST(Fluid, WallSensorsReadTheHydrostaticPressure) {
     EXPECT_NEAR(side, expected, bounds[k] * expected) << "side wall at y = " << heights[k];
   }
   std::cout << "\n";
-  EXPECT_NEAR(floor, 9810.0, 1.5 * 0.0279 * 9810.0);
+  EXPECT_NEAR(floor, 9810.0, 1.5 * 0.0032 * 9810.0);
 }
 
 // A sensor that cannot read: its normal pointing into the wall (no wall particle behind its face),
@@ -401,13 +419,14 @@ probes:
     if (t[k] >= 0.03 && t[k] <= 0.17) sum += p[k], ++n;
   const double s = 0.5 * (-0.5 + std::sqrt(0.25 + 400.0)), expected = (0.5 + s) * 0.5;
   std::cout << "water hammer on the wall: " << sum / n << " (" << expected << ")\n";
-  EXPECT_NEAR(sum / n, expected, 1.5 * 0.0174 * expected);  // measured 5.0373, -1.74%
+  EXPECT_NEAR(sum / n, expected, 1.5 * 0.0194 * expected);  // measured 5.0269, -1.94%
 }
 
 // Walls resist the fluid's approach, not its sliding: an inviscid layer of water sliding along a
 // floor (periodic along it) keeps its momentum. The Riemann dissipation along each pair's
 // direction with the whole velocity mirrored, as before, braked it to 65% of its speed within
-// 1 s; along the wall's normal the loss is round-off and acoustic noise.
+// 1 s; with the dissipation along the wall particles' own normals the layer loses 2.4e-4 of it
+// (7.2e-5 along the normal as each fluid particle sees it).
 TEST(Fluid, AnInviscidLayerSlidesAlongTheFloorWithoutFriction) {
   const std::string text = R"yaml(
 dimension: 2
@@ -437,7 +456,7 @@ modules:
     mass += water.scalar("mass")[i];
   }
   std::cout << "mean velocity along the floor after 1 s: " << momentum / mass << " (1)\n";
-  EXPECT_NEAR(momentum / mass, 1.0, 1.5 * 7.2e-5);  // measured 0.999928
+  EXPECT_NEAR(momentum / mass, 1.0, 1.5 * 2.43e-4);  // measured 0.999757
 }
 
 // Moving walls: the whole tank of the hydrostatic test moves sideways at 0.5 m/s with the water.

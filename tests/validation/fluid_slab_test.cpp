@@ -67,11 +67,11 @@ TEST(FluidSlab, DamBreakAsAPeriodicSlabReproducesThe2DFrontAndWallPressure) {
   const DamBreakRun slab = run("fluid_dambreak_3d_slab.yaml",
                                {"output.vtp=false", "checkpoint.at_end=false"}, "cosph_slab_3d", 2);
   COSPH_SKIP_CHECKS_IF_REDUCED();
-  // Measured front differences 0.0012, 0.0006, 0.0023, 0.0075 H at t = 0.5, 1, 1.5, 2; each
-  // bounded at 1.5x, but not below 0.004 H (a twelfth of the spacing: round-off changes move the
-  // front by a few thousandths).
+  // Measured front differences 0.0021, 0.0054, 0.0098, 0.0147 H at t = 0.5, 1, 1.5, 2 (the slab
+  // ahead by up to 0.3 spacing); each bounded at 1.5x, but not below 0.004 H (a twelfth of the
+  // spacing: round-off changes move the front by a few thousandths).
   const std::pair<double, double> fronts[] = {
-      {0.5, 0.004}, {1.0, 0.004}, {1.5, 0.004}, {2.0, 1.5 * 0.0075}};
+      {0.5, 0.004}, {1.0, 1.5 * 0.0054}, {1.5, 1.5 * 0.0098}, {2.0, 1.5 * 0.0147}};
   for (const auto& [t, bound] : fronts) {
     const double a = value_at(flat.front_t, flat.front, t),
                  b = value_at(slab.front_t, slab.front, t);
@@ -89,13 +89,14 @@ TEST(FluidSlab, DamBreakAsAPeriodicSlabReproducesThe2DFrontAndWallPressure) {
   std::cout << "sensor 1: impact 2D " << impact_2d << ", slab " << impact_3d << "; plateau 2D "
             << plateau_2d << ", slab " << plateau_3d << "; sensor 3 plateau 2D " << plateau3_2d
             << ", slab " << plateau3_3d << "\n";
-  // Measured: the same sample (every 0.01) for the impact; the plateaus 0.663 and 0.555-0.574 at
-  // sensor 1 (the slab lower: sensor 1's face lies within a kernel support of the floor, where the
-  // 3D kernel spreads the load differently), 0.778 and 0.725-0.750 at sensor 3 (the ranges: two
-  // builds whose round-off differs; the splashing plateau is chaotic).
+  // Measured: impacts 2.532 and 2.524 (one sample apart, every 0.01); the plateaus 0.599 and
+  // 0.593 at sensor 1, 0.758 and 0.734 at sensor 3. (The earlier wall scheme, dissipation along the
+  // normal as each fluid particle sees it, read the slab's sensor 1 0.11 lower.) The splashing
+  // plateau is chaotic: two builds whose round-off differed moved the slab's plateaus by 0.02 and
+  // 0.025, so each bound is 1.5x the difference plus that spread.
   EXPECT_NEAR(impact_3d, impact_2d, 0.02);  // two samples
-  EXPECT_NEAR(plateau_3d, plateau_2d, 1.5 * 0.108);
-  EXPECT_NEAR(plateau3_3d, plateau3_2d, 1.5 * 0.053);
+  EXPECT_NEAR(plateau_3d, plateau_2d, 1.5 * 0.006 + 0.02);
+  EXPECT_NEAR(plateau3_3d, plateau3_2d, 1.5 * 0.024 + 0.025);
 }
 
 }  // namespace

@@ -91,25 +91,26 @@ TEST(FluidValidation, DamBreakImpactAndPlateauAtSensorsOneAndThreeMatchTheExperi
   std::cout << "sensor 3: impact at " << impact3 << " (point probe " << impact3_point
             << "; experiment " << measured3 << "), plateau " << plateau3 << " (point probe "
             << mean_over(point3, 3.5, 5.5) << "; experiment " << expected3 << ")\n";
-  // Measured at H/40 (first samples past 0.5, every 0.005): sensor 1's impact 0.036 early by the
-  // wall sensor (1.5%), 0.044 by the point probe; sensor 3's 0.030 and 0.117 early.
-  EXPECT_NEAR(impact, measured, 1.5 * 0.036);
-  EXPECT_NEAR(impact_point, measured, 1.5 * 0.044);
-  EXPECT_NEAR(impact3, measured3, 1.5 * 0.030);
-  EXPECT_NEAR(impact3_point, measured3, 1.5 * 0.117);
-  // The plateaus (wall sensors) lie above the experiment's: 0.729 (+8.7%) and 0.804 (+36%; the
-  // point probes read 1.206 and 0.912). The run-up jet climbs to 2.8 H along the wall (0.8 H with
-  // the wall friction of the earlier scheme, whose point probes read 0.732 and 0.553 with a surge
-  // 0.26 late), and its weight and the water turning at the corner load the wall's foot.
-  EXPECT_NEAR(plateau, expected, 1.5 * 0.058);
-  EXPECT_NEAR(plateau3, expected3, 1.5 * 0.215);
+  // Measured at H/40 (first samples past 0.5, every 0.005): sensor 1's impact 0.0006 late by both
+  // probes (within one sample; bounded at one and a half samples); sensor 3's 0.035 early by the
+  // wall sensor, 0.076 by the point probe.
+  EXPECT_NEAR(impact, measured, 1.5 * 0.005);
+  EXPECT_NEAR(impact_point, measured, 1.5 * 0.005);
+  EXPECT_NEAR(impact3, measured3, 1.5 * 0.035);
+  EXPECT_NEAR(impact3_point, measured3, 1.5 * 0.076);
+  // The plateaus (wall sensors): 0.654 (-2.5%) and 0.654 (+11%; the point probes read 0.982 and
+  // 0.816). The run-up jet's weight and the water turning at the corner load the wall's foot.
+  // With the dissipation along the normal as each fluid particle sees it: 0.729 (+8.7%) and 0.804
+  // (+36%), the surge 0.036 early; with the wall friction of the earlier scheme 0.26 late.
+  EXPECT_NEAR(plateau, expected, 1.5 * 0.017);
+  EXPECT_NEAR(plateau3, expected3, 1.5 * 0.065);
 
   // The water level at gauge H1 (x = H), every time unit until the reflected wave returns.
   const Series gauge = read_probe(options.output_directory + "/gauge_H1.csv", 1);
   const Series level = read_experiment("lobovsky2014_gauge_H1.csv");
-  // Measured -0.0134, -0.0049, +0.0001, -0.0069 H at t = 1, 2, 3, 4; each bounded at 1.5x, except
-  // at t = 3, where the two curves happen to cross: there 0.004 H (a sixth of the H/40 spacing).
-  const std::map<double, double> bound = {{1.0, 0.020}, {2.0, 0.0074}, {3.0, 0.004}, {4.0, 0.0104}};
+  // Measured -0.0135, -0.0055, -0.0015, -0.0042 H at t = 1, 2, 3, 4; each bounded at 1.5x, but
+  // not below 0.004 H (a sixth of the H/40 spacing) where the two curves happen to cross.
+  const std::map<double, double> bound = {{1.0, 0.020}, {2.0, 0.0083}, {3.0, 0.004}, {4.0, 0.0063}};
   for (const auto& [t, allowed] : bound) {
     auto at = [t](const Series& s) {
       std::size_t k = 0;
