@@ -100,15 +100,29 @@ struct ReductionEntry : ProbeSet::Probe {
   }
 };
 
+// Throws a ConfigError naming key_of(k) for the first point outside the body's domain (a domain
+// with lower == upper is unbounded).
+template <int D, typename Key>
+void require_inside_domain(const std::vector<Vec<D>>& points, const Domain<D>& domain,
+                           const Key& key_of, const std::string& what) {
+  if (domain.upper == domain.lower) return;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    for (int a = 0; a < D; ++a)
+      if (points[k][a] < domain.lower[a] || points[k][a] > domain.upper[a])
+        throw ConfigError(key_of(k), what + " lies outside the domain");
+}
+
 template <int D>
 struct WallSensorEntry : ProbeSet::Probe {
   const BodyView<D>* body;
   WallSensor<D> sensor;
   WallSensorEntry(const BodyView<D>* b, WallSensor<D> s) : body(b), sensor(std::move(s)) {}
   std::vector<double> evaluate() const override {
-    return sensor.sample(*body->particles, body->particles->vector("force"),
-                         body->kernel.support_radius(), body->domain);
+    const ParticleSet<D>& wall = *body->particles;
+    return sensor.sample(cache.of(sensor, wall, body->kernel.support_radius(), body->domain),
+                         wall.vector("force"));
   }
+  mutable CoverageCache<D> cache;  // evaluate() is const; the cache only saves work
 };
 
 template <int D>
@@ -125,13 +139,9 @@ std::unique_ptr<ProbeSet::Probe> make_sensor(const proto::WallSensor& spec, cons
   if (!(normal.norm() > 0.0)) throw ConfigError(path + ".sensor.normal", "the normal is zero");
   std::vector<Vec<D>> centres;
   for (const auto& p : spec.at()) centres.push_back(to_vec<D>(p.coordinates()));
-  const Domain<D>& domain = body->domain;
-  for (std::size_t k = 0; k < centres.size(); ++k)
-    for (int a = 0; a < D; ++a)
-      if (domain.upper != domain.lower &&
-          (centres[k][a] < domain.lower[a] || centres[k][a] > domain.upper[a]))
-        throw ConfigError(path + ".sensor.at[" + std::to_string(k) + "]",
-                          "sensor lies outside the domain");
+  require_inside_domain<D>(
+      centres, body->domain,
+      [&](std::size_t k) { return path + ".sensor.at[" + std::to_string(k) + "]"; }, "sensor");
   std::unique_ptr<WallSensorEntry<D>> entry;
   try {
     entry =
@@ -183,12 +193,12 @@ std::unique_ptr<ProbeSet::Probe> make_probe(const proto::ProbeSpec& spec, const 
       } else {
         for (const auto& p : spec.points().at()) points.push_back(to_vec<D>(p.coordinates()));
       }
-      if (body->domain.upper != body->domain.lower)
-        for (std::size_t k = 0; k < points.size(); ++k)
-          for (int a = 0; a < D; ++a)
-            if (points[k][a] < body->domain.lower[a] || points[k][a] > body->domain.upper[a])
-              throw ConfigError(path + (line ? ".line" : ".points.at[" + std::to_string(k) + "]"),
-                                "probe point lies outside the domain");
+      require_inside_domain<D>(
+          points, body->domain,
+          [&](std::size_t k) {
+            return path + (line ? ".line" : ".points.at[" + std::to_string(k) + "]");
+          },
+          "probe point");
       std::vector<std::string> names(fields.begin(), fields.end());
       for (std::size_t k = 0; k < names.size(); ++k)
         check_field(names[k],

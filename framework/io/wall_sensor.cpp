@@ -96,29 +96,44 @@ void WallSensor<D>::for_each_covered(const ParticleSet<D>& wall, double depth,
 }
 
 template <int D>
+typename WallSensor<D>::Coverage WallSensor<D>::coverage(const ParticleSet<D>& wall, double depth,
+                                                         const Domain<D>& domain) const {
+  Coverage c;
+  c.weights.resize(centres_.size());
+  parallel_for_each_index(centres_.size(), [&](std::size_t s) {
+    for_each_covered(wall, depth, domain, s, [&](std::size_t w, double area, double share) {
+      c.weights[s].emplace_back(w, area / share);
+    });
+  });
+  return c;
+}
+
+template <int D>
+std::vector<double> WallSensor<D>::sample(const Coverage& coverage,
+                                          const std::vector<Vec<D>>& force) const {
+  std::vector<double> values(centres_.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t s = 0; s < centres_.size(); ++s) {
+    if (coverage.weights[s].empty()) continue;
+    double weighted = 0.0;
+    for (const auto& [w, weight] : coverage.weights[s]) weighted += weight * -force[w].dot(normal_);
+    values[s] = weighted / face_area();
+  }
+  return values;
+}
+
+template <int D>
 std::vector<double> WallSensor<D>::sample(const ParticleSet<D>& wall,
                                           const std::vector<Vec<D>>& force, double depth,
                                           const Domain<D>& domain) const {
-  std::vector<double> values(centres_.size(), std::numeric_limits<double>::quiet_NaN());
-  parallel_for_each_index(centres_.size(), [&](std::size_t s) {
-    double weighted = 0.0;
-    bool any = false;
-    for_each_covered(wall, depth, domain, s, [&](std::size_t w, double area, double share) {
-      weighted += area * -force[w].dot(normal_) / share;
-      any = true;
-    });
-    if (any) values[s] = weighted / face_area();
-  });
-  return values;
+  return sample(coverage(wall, depth, domain), force);
 }
 
 template <int D>
 std::vector<bool> WallSensor<D>::covered_by(const ParticleSet<D>& wall, double depth,
                                             const Domain<D>& domain) const {
-  std::vector<bool> covered(centres_.size(), false);
-  for (std::size_t s = 0; s < centres_.size(); ++s)
-    for_each_covered(wall, depth, domain, s,
-                     [&](std::size_t, double, double) { covered[s] = true; });
+  const Coverage c = coverage(wall, depth, domain);
+  std::vector<bool> covered(centres_.size());
+  for (std::size_t s = 0; s < centres_.size(); ++s) covered[s] = !c.weights[s].empty();
   return covered;
 }
 

@@ -2,6 +2,7 @@
 // face, from the force a fluid exerts on the wall particles behind that face.
 #pragma once
 
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -32,10 +33,20 @@ class WallSensor {
 
   const std::vector<Vec<D>>& centres() const { return centres_; }
 
-  // The pressures, one per sensor, from the wall particles' "position", "volume" and `force`
-  // (all required). `depth` bounds how far behind the face a particle still counts (the fluid's
-  // kernel support: deeper particles get no force, and a far wall must not count). Offsets are
-  // minimum images on the domain's periodic axes.
+  // What sample() needs of the wall, per sensor: the wall particles behind its face and each
+  // one's weight, the covered area over its share's area. It depends only on the wall's
+  // positions and volumes, so a static wall's is computed once.
+  struct Coverage {
+    std::vector<std::vector<std::pair<std::size_t, double>>> weights;
+  };
+  // From the wall particles' "position" and "volume". `depth` bounds how far behind the face a
+  // particle still counts (the fluid's kernel support: deeper particles get no force, and a far
+  // wall must not count). Offsets are minimum images on the domain's periodic axes.
+  Coverage coverage(const ParticleSet<D>& wall, double depth, const Domain<D>& domain = {}) const;
+  // The pressures, one per sensor (NaN where no particle covers it), from the force on each wall
+  // particle.
+  std::vector<double> sample(const Coverage& coverage, const std::vector<Vec<D>>& force) const;
+  // Both at once, from the wall particles' "position", "volume" and `force`.
   std::vector<double> sample(const ParticleSet<D>& wall, const std::vector<Vec<D>>& force,
                              double depth, const Domain<D>& domain = {}) const;
   // Whether any wall particle lies behind each sensor's face (what sample() needs to read it).
@@ -60,6 +71,27 @@ class WallSensor {
   std::vector<Vec<D>> tangents_;  // D - 1 unit vectors spanning the face's plane
   double radius_;
   std::vector<std::pair<double, double>> face_points_;  // 3D: the face's quadrature points
+};
+
+// A sensor's coverage kept while the wall's positions stay where they were: a static wall's is
+// computed once, a moving wall's again whenever it has moved.
+template <int D>
+class CoverageCache {
+ public:
+  const typename WallSensor<D>::Coverage& of(const WallSensor<D>& sensor,
+                                             const ParticleSet<D>& wall, double depth,
+                                             const Domain<D>& domain) {
+    const auto& x = wall.vector("position");
+    if (!coverage_ || x != positions_) {
+      coverage_ = sensor.coverage(wall, depth, domain);
+      positions_ = x;
+    }
+    return *coverage_;
+  }
+
+ private:
+  std::optional<typename WallSensor<D>::Coverage> coverage_;
+  std::vector<Vec<D>> positions_;
 };
 
 extern template class WallSensor<2>;

@@ -116,6 +116,20 @@ TEST(WallSensor, SensorOffTheWallReadsNaNAndBadInputThrows) {
   EXPECT_THROW(WallSensor<2>({Vec<2>(0.0, 0.0)}, Vec<2>::Unit(1), 0.0), std::invalid_argument);
 }
 
+// A moving wall: the cached coverage follows it. The wall with a linear pressure 1 + x slides by
+// 0.5 along the face: the sensor at x = 0.2 then reads the columns that arrived behind it (a
+// pressure of 0.7 where they started at -0.3), and NaN once the wall has left its face.
+TEST(WallSensor, CoverageCacheFollowsAMovingWall) {
+  Wall<2> wall([](const Vec<2>& x) { return 1.0 + x[0]; });
+  const WallSensor<2> sensor({Vec<2>(0.2, 0.0)}, Vec<2>::Unit(1), 0.1);
+  CoverageCache<2> cache;
+  EXPECT_NEAR(sensor.sample(cache.of(sensor, wall.particles, 0.35, {}), wall.force)[0], 1.2, 1e-12);
+  for (auto& x : wall.particles.vector("position")) x[0] += 0.5;
+  EXPECT_NEAR(sensor.sample(cache.of(sensor, wall.particles, 0.35, {}), wall.force)[0], 0.7, 1e-12);
+  for (auto& x : wall.particles.vector("position")) x[0] += 2.0;
+  EXPECT_TRUE(std::isnan(sensor.sample(cache.of(sensor, wall.particles, 0.35, {}), wall.force)[0]));
+}
+
 // A disc against the squares of a 3D wall: a small disc inside one square is covered whole, a
 // square far away not at all, and the squares of a lattice share a large disc between them
 // exactly. The squares' edges (side 1/8, centres k/8 + 5/64) fall on the face's quadrature points
