@@ -149,10 +149,11 @@ std::unique_ptr<ProbeSet::Probe> make_sensor(const proto::WallSensor& spec, cons
   } catch (const std::invalid_argument& e) {
     throw ConfigError(path + ".sensor", e.what());
   }
-  const auto covered =
-      entry->sensor.covered_by(particles, body->kernel.support_radius(), body->domain);
-  for (std::size_t k = 0; k < covered.size(); ++k)
-    if (!covered[k])
+  // The setup check fills the entry's cache: a static wall's coverage is computed this once.
+  const auto& coverage =
+      entry->cache.of(entry->sensor, particles, body->kernel.support_radius(), body->domain);
+  for (std::size_t k = 0; k < coverage.weights.size(); ++k)
+    if (coverage.weights[k].empty())
       throw ConfigError(path + ".sensor.at[" + std::to_string(k) + "]",
                         "no wall particle of '" + particles.name() +
                             "' lies behind this sensor's face (within the kernel's support along "
