@@ -128,15 +128,6 @@ std::vector<double> WallSensor<D>::sample(const ParticleSet<D>& wall,
   return sample(coverage(wall, depth, domain), force);
 }
 
-template <int D>
-std::vector<bool> WallSensor<D>::covered_by(const ParticleSet<D>& wall, double depth,
-                                            const Domain<D>& domain) const {
-  const Coverage c = coverage(wall, depth, domain);
-  std::vector<bool> covered(centres_.size());
-  for (std::size_t s = 0; s < centres_.size(); ++s) covered[s] = !c.weights[s].empty();
-  return covered;
-}
-
 template class WallSensor<2>;
 template class WallSensor<3>;
 

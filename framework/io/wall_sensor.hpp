@@ -49,10 +49,6 @@ class WallSensor {
   // Both at once, from the wall particles' "position", "volume" and `force`.
   std::vector<double> sample(const ParticleSet<D>& wall, const std::vector<Vec<D>>& force,
                              double depth, const Domain<D>& domain = {}) const;
-  // Whether any wall particle lies behind each sensor's face (what sample() needs to read it).
-  std::vector<bool> covered_by(const ParticleSet<D>& wall, double depth,
-                               const Domain<D>& domain = {}) const;
-
   // The area of a particle's share (side a, centred at `offset` from the face's centre) that the
   // face covers: exact in 2D; in 3D the share of the face's quadrature points (about 800 over
   // the disc) that fall in the square, times the face's area, so that the squares of a wall
