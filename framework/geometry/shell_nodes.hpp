@@ -7,14 +7,17 @@
 //   r_s(t) = rs_in + t (rs_out - rs_in),  r_l(t) = rl_in + t (rl_out - rl_in),   t in [0, 1],
 // and x = (r_s(t) sin u cos v, r_s(t) sin u sin v, r_l(t) cos u), where the latitude
 // u = u_b(t) + s (pi - u_b(t)) runs from the base plane (s = 0, cos u_b(t) = z_truncation / r_l(t))
-// to the apex (s = 1). Nodes sit on n_t + 1 layers in t and n_s + 1 rings in s (both uniform),
-// so that the endocardium (t = 0), epicardium (t = 1) and base (s = 0) carry nodes exactly; each
+// to the apex (s = 1). Nodes sit on n_t + 1 layers uniform in t and n_s + 1 rings whose s lie at
+// equal arc lengths along the mid-wall meridian (uniform in s, the rings would crowd at the apex,
+// where the meridian follows the short radius), so that the endocardium (t = 0), epicardium
+// (t = 1) and base (s = 0) carry nodes exactly; each
 // ring holds round(2 pi rho / spacing) nodes (at least 3) equally spaced in v from v = 0, and the
 // apex of each layer one node. n_t and n_s are the wall's thickness and the mid-wall meridian's
 // length over the spacing, rounded.
 //
-// Each node carries the volume of its dual cell (half an interval either side in t and s, clipped
-// at the faces, and its share of the ring in v), integrated exactly enough (Gauss-Legendre) that
+// Each node carries the volume of its dual cell (half an interval either side in t, halfway to the
+// neighbouring rings in s, clipped at the faces, and its share of the ring in v), integrated
+// exactly enough (Gauss-Legendre) that
 // the volumes sum to the shell's volume to round-off. The faces "inner", "outer" and "base" come
 // with each node's outward area vector over the same dual cell.
 #pragma once

@@ -75,7 +75,8 @@ class SolidModule final : public StaticBodyModule<D> {
     else
       f.push_back(spec_.integrator() == "rk4" ? "RK4 integrator" : "position Verlet integrator");
     if (spec_.has_artificial_viscosity()) f.push_back("artificial viscosity");
-    if (spec_.has_hourglass_control()) f.push_back("hourglass control");
+    if (pair_hourglass()) f.push_back("hourglass control");
+    if (fit_residual_hourglass()) f.push_back("hourglass control (fit residual)");
     if (spec_.damping() > 0.0 && !steady()) f.push_back("mass-proportional damping");
     if (spec_.load_ramp_time() > 0.0) f.push_back("load ramp");
     if (spec_.body_force_size() > 0) f.push_back("body force");
@@ -135,10 +136,13 @@ class SolidModule final : public StaticBodyModule<D> {
                                         spec_.gradient_correction() == "quadratic"
                                             ? GradientCorrection::quadratic
                                             : GradientCorrection::linear,
-                                        spec_.has_hourglass_control());
+                                        pair_hourglass());
     } catch (const RuntimeError& e) {
       throw RuntimeError("module '" + name_ + "': " + e.what());
     }
+    if (fit_residual_hourglass())
+      fit_control_.emplace(X_, volume, pairs_, kernel_,
+                           spec_.hourglass_control().coefficient() * material_.shear_modulus());
     F_.assign(n, Mat<D>::Identity());
     P_.assign(n, Mat<D>::Zero());
     if (spec_.has_artificial_viscosity()) {
@@ -638,8 +642,10 @@ class SolidModule final : public StaticBodyModule<D> {
                             std::vector<Vec<D>>& a) {
     const std::size_t n = u.size();
     const bool viscosity = spec_.has_artificial_viscosity();
-    const bool hourglass = spec_.has_hourglass_control();
+    const bool hourglass = pair_hourglass();
     update_active_tension(t);
+    if (fit_control_) fit_control_->update_residuals(u);
+    const auto& volume = particles_.scalar("volume");
     const std::size_t grain = pair_loop_grain(n, pairs_.neighbours.pair_count());
     parallel_for_each_index(
         n,
@@ -667,6 +673,7 @@ class SolidModule final : public StaticBodyModule<D> {
           Vec<D> force = pair_stress_divergence<D>(pairs_, P_, i);
           if (viscosity) force += artificial_viscosity<D>(pairs_, x_, v, density_, A_, viscous, i);
           if (hourglass) force += hourglass_force<D>(pairs_, X_, x_, F_, stiffness, i);
+          if (fit_control_) force += fit_control_->force(i) / volume[i];
           a[i] = force / rho0 + gravity;
         },
         grain);
@@ -802,6 +809,12 @@ class SolidModule final : public StaticBodyModule<D> {
   // ---- Steady state (static equilibrium by Newton, static_equilibrium.hpp) ----
 
   bool steady() const { return spec_.has_steady_state(); }
+  bool pair_hourglass() const {
+    return spec_.has_hourglass_control() && spec_.hourglass_control().form() == "pair";
+  }
+  bool fit_residual_hourglass() const {
+    return spec_.has_hourglass_control() && spec_.hourglass_control().form() == "fit_residual";
+  }
 
   static std::string short_number(double v) {
     std::ostringstream o;
@@ -810,7 +823,7 @@ class SolidModule final : public StaticBodyModule<D> {
   }
 
   // What a static solve cannot honour is refused with its key: it has no velocities, and the
-  // hourglass forces have no tangent here.
+  // pair hourglass forces have no tangent here.
   void check_steady_state_spec() const {
     const std::string why = " is not allowed with steady_state (a static solve has no velocities)";
     if (spec_.initial_velocity_size() > 0)
@@ -819,10 +832,10 @@ class SolidModule final : public StaticBodyModule<D> {
       throw ConfigError(key_ + ".time_step",
                         "time_step is not used with steady_state: its steps are the load "
                         "increments (steady_state.load_steps over load_ramp_time)");
-    if (spec_.has_hourglass_control())
+    if (pair_hourglass())
       throw ConfigError(key_ + ".hourglass_control",
-                        "hourglass control is not supported with steady_state (its forces have "
-                        "no tangent in the Newton solve)");
+                        "hourglass control of form 'pair' is not supported with steady_state (its "
+                        "forces have no tangent in the Newton solve); use form: fit_residual");
     for (int k = 0; k < spec_.constraints_size(); ++k)
       if (spec_.constraints(k).has_velocity())
         throw ConfigError(key_ + ".constraints[" + std::to_string(k) + "].velocity",
@@ -852,6 +865,7 @@ class SolidModule final : public StaticBodyModule<D> {
     static_body_.force = [this](double t, const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f) {
       return static_force(t, u, f);
     };
+    static_body_.control = fit_control_ ? &*fit_control_ : nullptr;
     static_body_.tangents = [this](double t, std::vector<MaterialTangent<D>>& C,
                                    std::vector<Index>& loaded, std::vector<ForceTangent<D>>& L) {
       static_tangents(t, C, loaded, L);
@@ -971,6 +985,7 @@ class SolidModule final : public StaticBodyModule<D> {
   static constexpr long long kStiffnessInterval = 1000;
   // Steady state only.
   std::optional<StaticEquilibrium<D>> equilibrium_;
+  std::optional<FitResidualControl<D>> fit_control_;  // hourglass_control of form fit_residual
   typename StaticEquilibrium<D>::Body static_body_;
   std::vector<char> prescribed_;  // per component: held by a constraint
   std::vector<Vec<D>> zero_velocity_, internal_force_;

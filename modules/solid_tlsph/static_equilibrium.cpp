@@ -38,7 +38,8 @@ NewtonOutcome StaticEquilibrium<D>::solve(double t_start, double t, std::vector<
   const auto tangent = [&](const Eigen::VectorXd&) {
     body.tangents(first ? t_start : t, C_, loaded_, L_);
     first = false;
-    return assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_, unknowns_);
+    return assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_, unknowns_,
+                               body.control);
   };
   const NewtonOutcome outcome = solver_.solve(x, residual, tangent, settings);
   scatter(x, u);

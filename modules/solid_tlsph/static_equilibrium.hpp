@@ -55,6 +55,9 @@ class StaticEquilibrium {
     std::function<void(double t, std::vector<MaterialTangent<D>>& C, std::vector<Index>& loaded,
                        std::vector<ForceTangent<D>>& L)>
         tangents;
+    // A zero-energy control whose force is part of `force`: its constant stiffness joins the
+    // tangent (null: none).
+    const FitResidualControl<D>* control = nullptr;
   };
 
   // prescribed[i * D + a]: component a of particle i is prescribed at every load.

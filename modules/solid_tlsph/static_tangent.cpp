@@ -69,8 +69,8 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
                                              const std::vector<MaterialTangent<D>>& C,
                                              const std::vector<Index>& force_tangent_particles,
                                              const std::vector<ForceTangent<D>>& force_tangents,
-                                             const std::vector<long long>& dof,
-                                             long long unknowns) {
+                                             const std::vector<long long>& dof, long long unknowns,
+                                             const FitResidualControl<D>* control) {
   using Block = Mat<D>;
   using Contracted = Eigen::Matrix<double, D * D, D>;
   const NeighbourList& nl = pairs.neighbours;
@@ -106,20 +106,21 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
   // Row j of K: sum over the particles i whose F depends on u_j (j itself and its neighbours).
   std::vector<Block> K(pattern.column.size(), Block::Zero());
   parallel_for_each_index(n, [&](std::size_t j) {
-    auto add_particle = [&](std::size_t i, const Vec<D>& c_ij) {
+    auto add_particle = [&](std::size_t i, std::size_t slot_of_j) {
+      const Vec<D> c_ij = coefficient(pairs, i, slot_of_j);
       for (std::size_t s = 0; s < slots(nl, i); ++s) {
         const Contracted& q = Q[slot_offset[i] + s];
         Block b = Block::Zero();
         for (int a = 0; a < D; ++a)
           for (int bb = 0; bb < D; ++bb) b.row(a) += c_ij[bb] * q.row(a * D + bb);
-        K[find_column(pattern, j, node(pairs, i, s))] += volume[i] * b;
+        b *= volume[i];
+        if (control) b.diagonal().array() += control->stiffness(i, slot_of_j, s);
+        K[find_column(pattern, j, node(pairs, i, s))] += b;
       }
     };
-    add_particle(j, coefficient(pairs, j, 0));
-    for (std::size_t k = nl.offset[j]; k < nl.offset[j + 1]; ++k) {
-      const Index i = nl.index[k];
-      add_particle(i, coefficient(pairs, i, slot_of_self_in[k]));
-    }
+    add_particle(j, 0);
+    for (std::size_t k = nl.offset[j]; k < nl.offset[j + 1]; ++k)
+      add_particle(nl.index[k], slot_of_self_in[k]);
     if (own_force[j] >= 0) {
       const ForceTangent<D>& L = force_tangents[static_cast<std::size_t>(own_force[j])];
       for (std::size_t s = 0; s < slots(nl, j); ++s) {
@@ -179,12 +180,13 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
   return matrix;
 }
 
-#define COSPH_INSTANTIATE_STATIC_TANGENT(D)                                        \
-  template TangentPattern build_tangent_pattern<D>(const ReferencePairs<D>&);      \
-  template Eigen::SparseMatrix<double> assemble_tangent<D>(                        \
-      const ReferencePairs<D>&, const TangentPattern&, const std::vector<double>&, \
-      const std::vector<MaterialTangent<D>>&, const std::vector<Index>&,           \
-      const std::vector<ForceTangent<D>>&, const std::vector<long long>&, long long);
+#define COSPH_INSTANTIATE_STATIC_TANGENT(D)                                          \
+  template TangentPattern build_tangent_pattern<D>(const ReferencePairs<D>&);        \
+  template Eigen::SparseMatrix<double> assemble_tangent<D>(                          \
+      const ReferencePairs<D>&, const TangentPattern&, const std::vector<double>&,   \
+      const std::vector<MaterialTangent<D>>&, const std::vector<Index>&,             \
+      const std::vector<ForceTangent<D>>&, const std::vector<long long>&, long long, \
+      const FitResidualControl<D>*);
 COSPH_INSTANTIATE_STATIC_TANGENT(2)
 COSPH_INSTANTIATE_STATIC_TANGENT(3)
 

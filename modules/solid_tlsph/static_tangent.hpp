@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/types.hpp"
+#include "solid_tlsph/fit_residual_control.hpp"
 #include "solid_tlsph/tlsph_operators.hpp"
 
 namespace cosph {
@@ -45,7 +46,8 @@ TangentPattern build_tangent_pattern(const ReferencePairs<D>& pairs);
 // own stiffness is not symmetric, and Newton's iteration with the symmetric part converges linearly
 // at the rate of the pressure's share of the stiffness of the deformation being solved for (small
 // against the material's, but not against a slender body's bending: 0.15-0.2 per iteration near the
-// solution of Land's beam, measured).
+// solution of Land's beam, measured). A zero-energy control (fit_residual_control.hpp), where
+// given, adds its constant stiffness.
 template <int D>
 Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
                                              const TangentPattern& pattern,
@@ -53,6 +55,7 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
                                              const std::vector<MaterialTangent<D>>& C,
                                              const std::vector<Index>& force_tangent_particles,
                                              const std::vector<ForceTangent<D>>& force_tangents,
-                                             const std::vector<long long>& dof, long long unknowns);
+                                             const std::vector<long long>& dof, long long unknowns,
+                                             const FitResidualControl<D>* control = nullptr);
 
 }  // namespace cosph
