@@ -1,11 +1,13 @@
 // The tangent stiffness of the steady-state solver (modules/solid_tlsph/static_tangent.hpp)
 // against finite differences of the forces it linearises: the stress divergence of a jittered,
 // unequal-volume body (linear and quadratic correction, so that no lattice symmetry hides an
-// index error), with clamped and fixed components and a follower pressure, in 2D and 3D. The
-// assembled matrix is the symmetric part of the Jacobian; every entry is compared.
+// index error), with clamped and fixed components and a follower pressure, in 2D and 3D, and with
+// the fit-residual hourglass control. The assembled matrix is the symmetric part of the Jacobian;
+// every entry is compared.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <optional>
 #include <random>
 
 #include "../support/tlsph_body.hpp"
@@ -26,6 +28,7 @@ struct Problem {
   double pressure = 0.0;
   std::vector<long long> dof;  // -1: prescribed
   long long unknowns = 0;
+  std::optional<FitResidualControl<D>> control;  // the hourglass control, where tested
 
   // Net force on every particle: V_i (stress divergence) minus p J F^-T N dA.
   std::vector<Vec<D>> force(const std::vector<Vec<D>>& u) const {
@@ -40,6 +43,11 @@ struct Problem {
       const Mat<D>& Fi = F[loaded[k]];
       f[loaded[k]] -= pressure * Fi.determinant() * (Fi.inverse().transpose() * area[k]);
     }
+    if (control) {
+      auto& c = const_cast<FitResidualControl<D>&>(*control);  // residual storage only
+      c.update_residuals(u);
+      for (std::size_t i = 0; i < n; ++i) f[i] += c.force(i);
+    }
     return f;
   }
 };
@@ -53,7 +61,7 @@ proto::MaterialSpec neo_hookean() {
 }
 
 template <int D>
-Problem<D> make_problem(GradientCorrection correction, unsigned seed) {
+Problem<D> make_problem(GradientCorrection correction, unsigned seed, bool control) {
   std::array<int, D> n;
   n.fill(4);
   n[0] = 6;
@@ -68,7 +76,10 @@ Problem<D> make_problem(GradientCorrection correction, unsigned seed) {
                {},
                0.0,
                {},
-               0};
+               0,
+               {}};
+  // kappa mu at half of E: the control's stiffness comparable to the material's.
+  if (control) p.control.emplace(p.body.X, p.body.V, p.body.pairs, p.body.kernel, 5e5);
   const std::size_t count = p.body.X.size();
   p.dof.assign(count * D, 0);
   for (std::size_t i = 0; i < count; ++i) {
@@ -90,8 +101,8 @@ Problem<D> make_problem(GradientCorrection correction, unsigned seed) {
 }
 
 template <int D>
-void check_tangent(GradientCorrection correction, unsigned seed) {
-  const Problem<D> p = make_problem<D>(correction, seed);
+void check_tangent(GradientCorrection correction, unsigned seed, bool control = false) {
+  const Problem<D> p = make_problem<D>(correction, seed, control);
   const std::size_t n = p.body.X.size();
   std::mt19937 rng(seed + 7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -116,7 +127,8 @@ void check_tangent(GradientCorrection correction, unsigned seed) {
         F[p.loaded[k]]);
   const TangentPattern pattern = build_tangent_pattern<D>(p.body.pairs);
   const Eigen::SparseMatrix<double> lower =
-      assemble_tangent<D>(p.body.pairs, pattern, p.body.V, C, p.loaded, L, p.dof, p.unknowns);
+      assemble_tangent<D>(p.body.pairs, pattern, p.body.V, C, p.loaded, L, p.dof, p.unknowns,
+                          p.control ? &*p.control : nullptr);
   const Eigen::MatrixXd upper_part = Eigen::MatrixXd(lower).triangularView<Eigen::StrictlyUpper>();
   EXPECT_EQ(upper_part.norm(), 0.0);  // the lower triangle only
   const Eigen::SparseMatrix<double> whole = lower.selfadjointView<Eigen::Lower>();
@@ -140,7 +152,8 @@ void check_tangent(GradientCorrection correction, unsigned seed) {
   const double asymmetry = (J - J.transpose()).norm() / J.norm();
   std::cout << D << "D " << (correction == GradientCorrection::linear ? "linear" : "quadratic")
             << ": |K - sym(J_fd)| / |J| = " << error << ", follower asymmetry " << asymmetry << ", "
-            << p.unknowns << " unknowns\n";
+            << p.unknowns << " unknowns" << (control ? ", with the fit-residual control" : "")
+            << "\n";
   EXPECT_LT(error, 1e-8);  // measured 0.98e-9 to 6.1e-9 (the differences' own error)
   // The pressure makes J unsymmetric; a test whose J were symmetric could not see the
   // symmetrisation at all.
@@ -155,6 +168,13 @@ TEST(SolidStaticTangent, MatchesTheSymmetricPartOfTheForceJacobian2D) {
 TEST(SolidStaticTangent, MatchesTheSymmetricPartOfTheForceJacobian3D) {
   check_tangent<3>(GradientCorrection::linear, 5);
   check_tangent<3>(GradientCorrection::quadratic, 6);
+}
+
+// The fit-residual hourglass control's constant stiffness joins the tangent: the same comparison
+// with its force in the residual.
+TEST(SolidStaticTangent, IncludesTheFitResidualControl) {
+  check_tangent<2>(GradientCorrection::linear, 8, true);
+  check_tangent<3>(GradientCorrection::quadratic, 9, true);
 }
 
 }  // namespace
