@@ -168,8 +168,32 @@ std::vector<Mat<D>> build_fibre_frames(const proto::FibreSpec& spec, const std::
   }
 }
 
+template <int D>
+std::vector<char> fibre_undefined_in_wall(const proto::FibreSpec& spec,
+                                          const std::vector<Vec<D>>& X) {
+  if constexpr (D == 3) {
+    if (!spec.has_ellipsoid_rule()) return {};
+    // On the axis up to the round-off of a placement's trigonometry; the nearest off-axis
+    // particles lie about a spacing away.
+    const double tolerance = 1e-9 * spec.ellipsoid_rule().outer_short_radius();
+    std::vector<char> undefined(X.size(), 0);
+    bool any = false;
+    for (std::size_t i = 0; i < X.size(); ++i)
+      if (std::hypot(X[i][0], X[i][1]) <= tolerance) undefined[i] = any = true;
+    return any ? undefined : std::vector<char>{};
+  } else {
+    (void)spec;
+    (void)X;
+    return {};
+  }
+}
+
 template Mat<2> orthonormal_frame<2>(const Vec<2>&, const Vec<2>&);
 template Mat<3> orthonormal_frame<3>(const Vec<3>&, const Vec<3>&);
+template std::vector<char> fibre_undefined_in_wall<2>(const proto::FibreSpec&,
+                                                      const std::vector<Vec<2>>&);
+template std::vector<char> fibre_undefined_in_wall<3>(const proto::FibreSpec&,
+                                                      const std::vector<Vec<3>>&);
 template std::vector<Mat<2>> build_fibre_frames<2>(const proto::FibreSpec&,
                                                    const std::vector<Vec<2>>&, double,
                                                    const std::string&, const std::string&);

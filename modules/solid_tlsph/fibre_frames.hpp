@@ -23,6 +23,16 @@ Mat<D> orthonormal_frame(const Vec<D>& f, const Vec<D>& s);
 // from the apex towards the base on the wall).
 Mat<3> land_ellipsoid_frame(const proto::EllipsoidFibreRule& rule, const Vec<3>& x);
 
+// Per particle 1 where the scene's fibre rule leaves the fibre's direction within the wall
+// undefined, else 0; empty where it is defined everywhere (constant and CSV fibres). The ellipsoid
+// rule is singular on the long axis (rho = 0, the apex nodes of a conforming placement): there the
+// helix field turns through every direction of the wall's plane around the point, and only its
+// average over those directions, (I - s0 (x) s0) / 2 with s0 the sheet (the wall normal), has a
+// limit. The frame the rule gives there has an arbitrary fibre in that plane.
+template <int D>
+std::vector<char> fibre_undefined_in_wall(const proto::FibreSpec& spec,
+                                          const std::vector<Vec<D>>& X);
+
 // Frames of all particles (reference positions X) from the scene's fibre spec: constant (default
 // fibre x, sheet y), nearest row of a CSV file (within 2 spacings), or the ellipsoid rule.
 // Errors are ConfigErrors at `key` (e.g. "modules[0].solid.fibres").

@@ -38,7 +38,6 @@ FitResidualControl<D>::FitResidualControl(const std::vector<Vec<D>>& X,
   residual_.assign(count, Vec<D>::Zero());
   p_sum_.assign(n, Basis::Zero());
   coefficient_.assign(n, 0.0);
-  reverse_.resize(count);
   parallel_for_each_index(n, [&](std::size_t i) {
     const bool quadratic = !pairs.quadratic.empty() && pairs.quadratic[i];
     const int m = quadratic ? kBasis : D;
@@ -53,9 +52,6 @@ FitResidualControl<D>::FitResidualControl(const std::vector<Vec<D>>& X,
       M.noalias() += omega_[k] * p_[k] * p_[k].transpose();
       p_sum_[i] += omega_[k] * p_[k];
       spread += omega_[k] * X_ij.squaredNorm();
-      std::size_t back = nl.offset[j];
-      while (nl.index[back] != Index(i)) ++back;  // reference lists are symmetric
-      reverse_[k] = back;
     }
     // The fit's own moment matrix (the correction already refused a singular one: this
     // particle then has the linear fit, whose D x D block is invertible).
@@ -86,7 +82,7 @@ Vec<D> FitResidualControl<D>::force(std::size_t k) const {
   Vec<D> f = Vec<D>::Zero();
   for (std::size_t q = nl.offset[k]; q < nl.offset[k + 1]; ++q) {
     const Index i = nl.index[q];
-    const std::size_t back = reverse_[q];  // pair (i, k)
+    const std::size_t back = pairs_.reverse_pair[q];  // pair (i, k)
     f += coefficient_[k] * omega_[q] * residual_[q] -
          coefficient_[i] * omega_[back] * residual_[back];
   }

@@ -52,12 +52,11 @@ class FitResidualControl {
   double column_sum(std::size_t i, std::size_t pair) const;  // sum over a >= 1 of K_i(a, b)
 
   const ReferencePairs<D>& pairs_;
-  std::vector<double> omega_;         // per pair
-  std::vector<Basis> p_, y_;          // per pair: p(s_ij), M_i^-1 omega_ij p(s_ij)
-  std::vector<Basis> p_sum_;          // per particle: sum_j omega_ij p(s_ij)
-  std::vector<double> coefficient_;   // per particle: 2 c_i
-  std::vector<std::size_t> reverse_;  // per pair (i, j): the index of pair (j, i)
-  std::vector<Vec<D>> residual_;      // per pair
+  std::vector<double> omega_;        // per pair
+  std::vector<Basis> p_, y_;         // per pair: p(s_ij), M_i^-1 omega_ij p(s_ij)
+  std::vector<Basis> p_sum_;         // per particle: sum_j omega_ij p(s_ij)
+  std::vector<double> coefficient_;  // per particle: 2 c_i
+  std::vector<Vec<D>> residual_;     // per pair
 };
 
 }  // namespace cosph

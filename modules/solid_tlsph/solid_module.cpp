@@ -130,6 +130,7 @@ class SolidModule final : public StaticBodyModule<D> {
     if (has_frames() || spec_.has_fibres()) {
       frames_ = build_fibre_frames<D>(spec_.fibres(), X_, spec_.body().spacing(), key_ + ".fibres",
                                       Base::scene_directory_);
+      fibre_undefined_ = fibre_undefined_in_wall<D>(spec_.fibres(), X_);
     }
     try {
       pairs_ = build_reference_pairs<D>(X_, volume, kernel_,
@@ -292,9 +293,11 @@ class SolidModule final : public StaticBodyModule<D> {
                            "': its active tension is prescribed by the scene; it reads no port");
       if (!particles_.has("active_tension")) {
         active_ = &particles_.add_scalar("active_tension", {.output = true, .checkpoint = true});
-        if (!has_frames())
+        if (!has_frames()) {
           frames_ = build_fibre_frames<D>(spec_.fibres(), X_, spec_.body().spacing(),
                                           key_ + ".fibres", Base::scene_directory_);
+          fibre_undefined_ = fibre_undefined_in_wall<D>(spec_.fibres(), X_);
+        }
       }
       // The port carries the active_stress module's field `active_stress` (T_a per particle).
       auto it = in.arrays.find("active_stress");
@@ -439,12 +442,19 @@ class SolidModule final : public StaticBodyModule<D> {
     return std::sqrt(1.5 * (dev.array() * dev.array()).sum());
   }
 
-  // P of particle i: the law plus the active stress T_a F f0 (x) f0.
+  // P of particle i: the law plus the active stress T_a F A0, A0 = f0 (x) f0; where the fibre
+  // rule leaves f0 undefined within the wall, A0 is its average over the wall's directions,
+  // (I - s0 (x) s0) / 2 (fibre_undefined_in_wall), not one arbitrary direction's pull.
   Mat<D> first_piola(std::size_t i, const Mat<D>& F, const Mat<D>& frame) const {
     Mat<D> P = material_.stress(F, frame);
     if (active_ && (*active_)[i] != 0.0) {
-      const Vec<D> f0 = frame.col(0);
-      P.noalias() += (*active_)[i] * (F * f0) * f0.transpose();
+      if (!fibre_undefined_.empty() && fibre_undefined_[i]) {
+        const Vec<D> s0 = frame.col(1);
+        P.noalias() += 0.5 * (*active_)[i] * (F - (F * s0) * s0.transpose());
+      } else {
+        const Vec<D> f0 = frame.col(0);
+        P.noalias() += (*active_)[i] * (F * f0) * f0.transpose();
+      }
     }
     return P;
   }
@@ -973,6 +983,7 @@ class SolidModule final : public StaticBodyModule<D> {
   std::vector<Vec<D>> X_, x_;
   std::vector<Mat<D>> frames_, F_, P_, A_;  // P: first Piola; A = J F^-T (viscosity)
   std::vector<double> density_;
+  std::vector<char> fibre_undefined_;  // per particle, where the fibre rule is singular; or empty
   const std::vector<double>* active_ = nullptr;  // T_a per particle, when there is one
   ReferencePairs<D> pairs_;
   std::vector<Constraint> constraints_;

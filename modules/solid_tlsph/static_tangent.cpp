@@ -92,12 +92,8 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
         q.col(col) = sum;
       }
     }
-    for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
-      const Index j = nl.index[k];
-      std::size_t back = nl.offset[j];
-      while (nl.index[back] != Index(i)) ++back;  // symmetric lists: present
-      slot_of_self_in[k] = back - nl.offset[j] + 1;
-    }
+    for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k)
+      slot_of_self_in[k] = pairs.reverse_pair[k] - nl.offset[nl.index[k]] + 1;
   });
   std::vector<long long> own_force(n, -1);
   for (std::size_t m = 0; m < force_tangent_particles.size(); ++m)

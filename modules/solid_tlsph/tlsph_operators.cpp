@@ -67,13 +67,11 @@ bool quadratic_gradients(const std::vector<Vec<D>>& X, const NeighbourList& nl,
   return true;
 }
 
-// b_ij = -(V_j / V_i) g_ji, found through the reverse pair (reference neighbour lists are
-// symmetric: j sees i whenever i sees j).
-template <int D>
-void reverse_gradients(const NeighbourList& nl, const std::vector<double>& volume,
-                       ReferencePairs<D>& pairs) {
-  pairs.reverse.resize(nl.pair_count());
-  parallel_for_each_index(volume.size(), [&](std::size_t i) {
+// Per pair (i, j) the index of the pair (j, i). Reference neighbour lists are symmetric (j sees i
+// whenever i sees j); a list that is not is refused, naming the particle.
+std::vector<std::size_t> reverse_pairs(const NeighbourList& nl) {
+  std::vector<std::size_t> reverse(nl.pair_count());
+  parallel_for_each_index(nl.particle_count(), [&](std::size_t i) {
     for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
       const Index j = nl.index[k];
       std::size_t back = nl.offset[j];
@@ -81,7 +79,21 @@ void reverse_gradients(const NeighbourList& nl, const std::vector<double>& volum
       if (back == nl.offset[j + 1])
         throw RuntimeError("reference neighbour list is not symmetric at particle " +
                            std::to_string(i));
-      pairs.reverse[k] = -(volume[j] / volume[i]) * pairs.gradient[back];
+      reverse[k] = back;
+    }
+  });
+  return reverse;
+}
+
+// b_ij = -(V_j / V_i) g_ji, through the reverse pair.
+template <int D>
+void reverse_gradients(const NeighbourList& nl, const std::vector<double>& volume,
+                       ReferencePairs<D>& pairs) {
+  pairs.reverse.resize(nl.pair_count());
+  parallel_for_each_index(volume.size(), [&](std::size_t i) {
+    for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
+      const Index j = nl.index[k];
+      pairs.reverse[k] = -(volume[j] / volume[i]) * pairs.gradient[pairs.reverse_pair[k]];
     }
   });
 }
@@ -121,6 +133,7 @@ ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
     pairs.gradient_sum[i] = sum;
   });
   pairs.quadratic = std::move(quadratic);
+  pairs.reverse_pair = reverse_pairs(nl);
   reverse_gradients<D>(nl, volume, pairs);
   return pairs;
 }

@@ -40,11 +40,12 @@ enum class GradientCorrection { linear, quadratic };
 
 template <int D>
 struct ReferencePairs {
-  NeighbourList neighbours;          // in the reference configuration, self excluded
-  std::vector<Vec<D>> gradient;      // g_ij, one per pair
-  std::vector<Vec<D>> reverse;       // b_ij = -(V_j / V_i) g_ji, one per pair
-  std::vector<Vec<D>> gradient_sum;  // sum_j g_ij, one per particle
-  std::vector<char> quadratic;       // per particle: 1 where the quadratic correction holds
+  NeighbourList neighbours;               // in the reference configuration, self excluded
+  std::vector<Vec<D>> gradient;           // g_ij, one per pair
+  std::vector<Vec<D>> reverse;            // b_ij = -(V_j / V_i) g_ji, one per pair
+  std::vector<std::size_t> reverse_pair;  // per pair (i, j): the index of the pair (j, i)
+  std::vector<Vec<D>> gradient_sum;       // sum_j g_ij, one per particle
+  std::vector<char> quadratic;            // per particle: 1 where the quadratic correction holds
   std::size_t quadratic_particles() const {
     return static_cast<std::size_t>(std::count(quadratic.begin(), quadratic.end(), char(1)));
   }

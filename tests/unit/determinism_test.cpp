@@ -4,8 +4,9 @@
 // its probe CSVs and ParaView collections continuing across the restart. Each scene is small
 // (a few hundred particles) but runs the features it names: the monodomain's ionic models,
 // fibre fields and stimuli; active stress's ODE; the solid's damping, artificial viscosity,
-// hourglass control, pressure, body force and prescribed motion; the free-surface fluid past
-// its periodic cell re-sorts (every 100 steps), moving walls, the FSI coupler's contact.
+// hourglass control of both forms, pressure, body force, prescribed motion and steady state; the
+// free-surface fluid past its periodic cell re-sorts (every 100 steps), moving walls, the FSI
+// coupler's contact.
 #include "../support/determinism.hpp"
 
 #include <gtest/gtest.h>
@@ -164,6 +165,28 @@ TEST(Determinism, SolidWithEveryLoadAndConstraintVerlet) {
 
 TEST(Determinism, SolidWithEveryLoadAndConstraintRk4) {
   check_determinism({loaded_plate("rk4"), {}, 0.02, 100}, "solid_loaded_rk4");
+}
+
+// The same plate with the fit-residual hourglass control and quadratic gradient correction: the
+// control's force is gathered per particle through the reverse pairs (fit_residual_control.hpp).
+TEST(Determinism, SolidFitResidualHourglassControl) {
+  check_determinism({loaded_plate("verlet"),
+                     {"modules[0].solid.hourglass_control.form=fit_residual",
+                      "modules[0].solid.gradient_correction=quadratic"},
+                     0.02,
+                     200},
+                    "solid_fit_residual");
+}
+
+// Land's problem 3 as a steady state (quasi-Newton, sparse tangent with the control's stiffness,
+// fibres singular on the axis) in two load increments, the checkpoint between them.
+TEST(Determinism, SteadyActiveVentricle3D) {
+  check_determinism({example("solid_land_ventricle_active_static.yaml"),
+                     {"modules[0].solid.body.spacing=0.002",
+                      "modules[0].solid.steady_state.load_steps=2", "output.vtp=false"},
+                     1.0,
+                     2},
+                    "solid_steady_ventricle");
 }
 
 // Holzapfel-Ogden myocardium with fibres, prescribed active tension and damping, in 3D.

@@ -271,6 +271,64 @@ TEST(SolidModule, ActiveStressPortReadsTheFieldItDeclares) {
   EXPECT_NEAR(face_stretch(particles_of<3>(*simulation), 0) / 0.5, -0.0459879, 1e-6);
 }
 
+// Land's ellipsoid fibre rule turns through every direction of the wall around the long axis, so
+// on the axis (the apex nodes of a conforming placement) no fibre is the right one: the active
+// tension there pulls equally along the wall, T_a (I - e_z (x) e_z) / 2 in the reference state,
+// whatever frame the rule returned. Off the axis it pulls along the fibre. One step of 1e-12 s
+// leaves F = I to round-off, so sigma is the active stress itself (neo-Hookean: 0 at F = I).
+const char* const kActiveVentricle = R"yaml(
+dimension: 3
+end_time: 1.0e-12
+modules:
+  - name: ventricle
+    solid:
+      body:
+        spacing: 0.002
+        placement: conforming
+        shape:
+          truncated_ellipsoidal_shell:
+            inner_short_radius: 0.007
+            inner_long_radius: 0.017
+            outer_short_radius: 0.010
+            outer_long_radius: 0.020
+            truncation: 0.005
+      material: {density: 1000, neo_hookean: {young: 1.0e5, poisson: 0.3}}
+      time_step: 1.0e-12
+      outputs: [stress]
+      active_tension: "1000"
+      fibres:
+        ellipsoid_rule: {inner_short_radius: 0.007, inner_long_radius: 0.017,
+                         outer_short_radius: 0.010, outer_long_radius: 0.020}
+)yaml";
+
+TEST(SolidModule, ActiveTensionOnTheVentricleAxisPullsEquallyAlongTheWall) {
+  auto simulation = make_simulation(kActiveVentricle);
+  simulation->run();
+  simulation->module(0).prepare_output();
+  const ParticleSet<3>& p = particles_of<3>(*simulation);
+  const auto& X = p.vector("reference_position");
+  const auto& sigma = p.matrix("stress");
+  const Mat<3> in_wall =
+      500.0 * (Mat<3>::Identity() - Vec<3>::UnitZ() * Vec<3>::UnitZ().transpose());
+  int on_axis = 0, off_axis = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (std::hypot(X[i][0], X[i][1]) < 1e-12) {
+      ++on_axis;
+      EXPECT_LT((sigma[i] - in_wall).norm(), 1e-6)
+          << "axis particle at " << X[i].transpose() << ":\n"
+          << sigma[i];
+    } else if (off_axis < 50) {
+      // Uniaxial along a unit fibre: trace T_a, and sigma^2 = T_a sigma.
+      ++off_axis;
+      EXPECT_NEAR(sigma[i].trace(), 1000.0, 1e-6);
+      EXPECT_LT((sigma[i] * sigma[i] - 1000.0 * sigma[i]).norm(), 1e-3);
+    }
+  }
+  std::cout << on_axis << " particles on the axis of " << p.size() << "\n";
+  // The conforming placement puts a node of every layer through the wall on the axis.
+  EXPECT_GE(on_axis, 2);
+}
+
 // ---- 4. The interface and external_force ports -----------------------------------------------
 
 const char* const kFreePlate = R"yaml(
