@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Unit tests of bench/land_strains.py (seed 000 eq. 25 point-pair strains) on deformations with
-known strains: a uniform stretch, a rigid rotation about the long axis, and an axial stretch."""
+known strains: a uniform stretch, a rigid rotation about the long axis, and an axial stretch; and
+of bench/land_meridians.py's view (distance from the axis against z) and plot."""
 import math
 import sys
 import tempfile
@@ -8,6 +9,7 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+import land_meridians  # noqa: E402
 import land_strains  # noqa: E402
 
 # Points of an endocardial-like meridian, base to apex (on v = 0), and the epicardial one.
@@ -65,6 +67,28 @@ class PointPairStrains(unittest.TestCase):
         (x0, _, z0), (x1, _, z1) = ENDO[0], ENDO[1]
         expect = (math.hypot(x1 - x0, 1.2 * (z1 - z0)) / math.hypot(x1 - x0, z1 - z0) - 1) * 100
         self.assertAlmostEqual(lon[0], expect, places=9)
+
+
+class MeridianView(unittest.TestCase):
+    def test_twist_keeps_the_profile_and_the_plot_is_written(self):
+        a = 0.9  # a twist about the long axis, growing towards the apex, and a 10% shortening
+        twist = lambda p: (math.cos(a * -p[2] / 20) * p[0] - math.sin(a * -p[2] / 20) * p[1],  # noqa: E731
+                           math.sin(a * -p[2] / 20) * p[0] + math.cos(a * -p[2] / 20) * p[1],
+                           0.9 * p[2])
+        with tempfile.TemporaryDirectory() as d:
+            write(Path(d) / "endocardial_meridian.csv", ENDO, twist)
+            write(Path(d) / "epicardial_meridian.csv", EPI, twist)
+            points = land_strains.read_meridian(Path(d) / "endocardial_meridian.csv")
+            rho0, z0 = land_meridians.radial_profile(points, deformed=False)
+            rho, z = land_meridians.radial_profile(points, deformed=True)
+            for k in range(len(points)):
+                self.assertAlmostEqual(rho[k], rho0[k], places=9)  # mm: the twist moves no radius
+                self.assertAlmostEqual(z[k], 0.9 * z0[k], places=9)
+            self.assertAlmostEqual(rho0[0], 1e3 * ENDO[0][0], places=9)  # metres in, mm out
+            png = Path(d) / "meridians.png"
+            self.assertEqual(land_meridians.main(["land_meridians.py", str(png), f"run={d}"]), 0)
+            self.assertGreater(png.stat().st_size, 1000)
+        self.assertEqual(land_meridians.main(["land_meridians.py", "only.png"]), 2)
 
 
 if __name__ == "__main__":
