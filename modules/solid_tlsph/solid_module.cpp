@@ -127,11 +127,7 @@ class SolidModule final : public StaticBodyModule<D> {
 
     // A fibre spec is checked even when nothing needs it yet (a coupler may send active stress
     // later): its errors belong at start-up, with the scene line.
-    if (has_frames() || spec_.has_fibres()) {
-      frames_ = build_fibre_frames<D>(spec_.fibres(), X_, spec_.body().spacing(), key_ + ".fibres",
-                                      Base::scene_directory_);
-      fibre_undefined_ = fibre_undefined_in_wall<D>(spec_.fibres(), X_);
-    }
+    if (has_frames() || spec_.has_fibres()) build_frames();
     try {
       pairs_ = build_reference_pairs<D>(X_, volume, kernel_,
                                         spec_.gradient_correction() == "quadratic"
@@ -293,11 +289,7 @@ class SolidModule final : public StaticBodyModule<D> {
                            "': its active tension is prescribed by the scene; it reads no port");
       if (!particles_.has("active_tension")) {
         active_ = &particles_.add_scalar("active_tension", {.output = true, .checkpoint = true});
-        if (!has_frames()) {
-          frames_ = build_fibre_frames<D>(spec_.fibres(), X_, spec_.body().spacing(),
-                                          key_ + ".fibres", Base::scene_directory_);
-          fibre_undefined_ = fibre_undefined_in_wall<D>(spec_.fibres(), X_);
-        }
+        if (!has_frames()) build_frames();
       }
       // The port carries the active_stress module's field `active_stress` (T_a per particle).
       auto it = in.arrays.find("active_stress");
@@ -413,6 +405,13 @@ class SolidModule final : public StaticBodyModule<D> {
     return material_.anisotropic() || spec_.has_active_tension() || !frames_.empty() ||
            std::find(spec_.outputs().begin(), spec_.outputs().end(), "fibre_strain") !=
                spec_.outputs().end();
+  }
+
+  // The fibre frames and where the rule leaves the fibre undefined (first_piola reads both).
+  void build_frames() {
+    frames_ = build_fibre_frames<D>(spec_.fibres(), X_, spec_.body().spacing(), key_ + ".fibres",
+                                    Base::scene_directory_);
+    fibre_undefined_ = fibre_undefined_in_wall<D>(spec_.fibres(), X_);
   }
 
   double load_factor(double t) const {

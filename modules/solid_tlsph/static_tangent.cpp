@@ -80,8 +80,6 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
   std::vector<std::size_t> slot_offset(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) slot_offset[i + 1] = slot_offset[i] + slots(nl, i);
   std::vector<Contracted> Q(slot_offset[n]);
-  // Where j sits among i's slots, per pair (i, j): the reverse lookup of the gather below.
-  std::vector<std::size_t> slot_of_self_in(nl.pair_count());
   parallel_for_each_index(n, [&](std::size_t i) {
     for (std::size_t s = 0; s < slots(nl, i); ++s) {
       const Vec<D> c = coefficient(pairs, i, s);
@@ -92,8 +90,6 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
         q.col(col) = sum;
       }
     }
-    for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k)
-      slot_of_self_in[k] = pairs.reverse_pair[k] - nl.offset[nl.index[k]] + 1;
   });
   std::vector<long long> own_force(n, -1);
   for (std::size_t m = 0; m < force_tangent_particles.size(); ++m)
@@ -115,8 +111,9 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
       }
     };
     add_particle(j, 0);
+    // Neighbour i's slot of j: the reverse pair's place in i's list (slot 0 is i itself).
     for (std::size_t k = nl.offset[j]; k < nl.offset[j + 1]; ++k)
-      add_particle(nl.index[k], slot_of_self_in[k]);
+      add_particle(nl.index[k], pairs.reverse_pair[k] - nl.offset[nl.index[k]] + 1);
     if (own_force[j] >= 0) {
       const ForceTangent<D>& L = force_tangents[static_cast<std::size_t>(own_force[j])];
       for (std::size_t s = 0; s < slots(nl, j); ++s) {

@@ -28,7 +28,8 @@ struct Problem {
   double pressure = 0.0;
   std::vector<long long> dof;  // -1: prescribed
   long long unknowns = 0;
-  std::optional<FitResidualControl<D>> control;  // the hourglass control, where tested
+  // The hourglass control, where tested; mutable: force() refreshes its residual storage.
+  mutable std::optional<FitResidualControl<D>> control;
 
   // Net force on every particle: V_i (stress divergence) minus p J F^-T N dA.
   std::vector<Vec<D>> force(const std::vector<Vec<D>>& u) const {
@@ -44,9 +45,8 @@ struct Problem {
       f[loaded[k]] -= pressure * Fi.determinant() * (Fi.inverse().transpose() * area[k]);
     }
     if (control) {
-      auto& c = const_cast<FitResidualControl<D>&>(*control);  // residual storage only
-      c.update_residuals(u);
-      for (std::size_t i = 0; i < n; ++i) f[i] += c.force(i);
+      control->update_residuals(u);
+      for (std::size_t i = 0; i < n; ++i) f[i] += control->force(i);
     }
     return f;
   }
