@@ -134,17 +134,27 @@ bool NewtonSolver::line_search(const Eigen::VectorXd& step, const Residual& resi
   return false;
 }
 
-bool NewtonSolver::refresh_tangent(const Eigen::VectorXd& x, const Tangent& tangent,
-                                   NewtonOutcome& outcome) {
-  const Eigen::SparseMatrix<double> K = tangent(x);
+int NewtonSolver::factorise(const Eigen::SparseMatrix<double>& K) {
   const auto start = std::chrono::steady_clock::now();
   const int shifts = factorisation_->factorise(K);
   factorisation_seconds_ +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  history_.clear();
+  factorised_ = shifts >= 0;
+  return shifts;
+}
+
+bool NewtonSolver::refresh_tangent(const Eigen::VectorXd& x, const Tangent& tangent,
+                                   NewtonOutcome& outcome) {
+  const int shifts = factorise(tangent(x));
   ++outcome.factorisations;
   if (shifts > 0) ++outcome.shifted_factorisations;
-  history_.clear();
   return shifts >= 0;
+}
+
+bool NewtonSolver::adopt_tangent(const Eigen::SparseMatrix<double>& K) {
+  kept_ = factorise(K) >= 0;
+  return kept_;
 }
 
 NewtonOutcome NewtonSolver::solve(Eigen::VectorXd& x, const Residual& residual,
@@ -157,7 +167,8 @@ NewtonOutcome NewtonSolver::solve(Eigen::VectorXd& x, const Residual& residual,
   ++outcome.residual_evaluations;
   at.norm = norm_or_infinity(at.r);
   auto converged = [&] { return at.norm == 0.0 || at.norm <= settings.tolerance * at.scale; };
-  bool stale = true;  // the factorisation is not of a tangent of this solve
+  history_.clear();
+  bool stale = !kept_;  // no factorisation to start from
   while (!converged() && std::isfinite(at.norm) && outcome.iterations < settings.max_iterations) {
     if (stale) {
       if (!refresh_tangent(at.x, tangent, outcome)) break;
@@ -187,6 +198,8 @@ NewtonOutcome NewtonSolver::solve(Eigen::VectorXd& x, const Residual& residual,
   }
   x = at.x;
   outcome.converged = converged();
+  // A failed solve's factorisation may be of a state far from any equilibrium.
+  kept_ = outcome.converged && factorised_;
   outcome.relative_residual = at.scale > 0.0 ? at.norm / at.scale : at.norm;
   return outcome;
 }

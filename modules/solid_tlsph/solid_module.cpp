@@ -323,6 +323,12 @@ class SolidModule final : public StaticBodyModule<D> {
       state.integers["tangent_factorisations"] = factorisations_;
       state.integers["shifted_factorisations"] = shifted_factorisations_;
       state.scalars["relative_residual"] = steady_residual_;
+      if (const auto* point = equilibrium_->kept_tangent()) {
+        auto& u = state.arrays["steady_tangent_displacement"];
+        for (const Vec<D>& ui : point->u) u.insert(u.end(), ui.data(), ui.data() + D);
+        state.scalars["steady_tangent_force_time"] = point->force_time;
+        state.scalars["steady_tangent_load_time"] = point->tangent_time;
+      }
     }
   }
 
@@ -351,6 +357,9 @@ class SolidModule final : public StaticBodyModule<D> {
       factorisations_ = read.integer("tangent_factorisations");
       shifted_factorisations_ = read.integer("shifted_factorisations");
       steady_residual_ = read.scalar("relative_residual");
+      if (const auto* u = read.optional_array("steady_tangent_displacement", D * X_.size()))
+        restore_steady_tangent(*u, read.scalar("steady_tangent_force_time"),
+                               read.scalar("steady_tangent_load_time"));
     }
     const auto& u = particles_.vector("displacement");
     auto& x = particles_.vector("position");
@@ -930,6 +939,27 @@ class SolidModule final : public StaticBodyModule<D> {
             },
             F_[i]);
       }
+  }
+
+  // The factorisation the uninterrupted run would start its next increment on, rebuilt where the
+  // checkpoint says it was taken, so that a restart continues bit for bit.
+  void restore_steady_tangent(const std::vector<double>& flat, double force_time,
+                              double tangent_time) {
+    const bool finite =
+        std::isfinite(force_time) && std::isfinite(tangent_time) &&
+        std::all_of(flat.begin(), flat.end(), [](double v) { return std::isfinite(v); });
+    if (!finite)
+      throw RuntimeError("module '" + name_ +
+                         "': the checkpoint's steady-state tangent point is not finite");
+    typename StaticEquilibrium<D>::TangentPoint point{std::vector<Vec<D>>(X_.size()), force_time,
+                                                      tangent_time};
+    for (std::size_t i = 0; i < X_.size(); ++i)
+      point.u[i] = Eigen::Map<const Vec<D>>(flat.data() + i * D);
+    try {
+      equilibrium_->restore_tangent(point, static_body_);
+    } catch (const RuntimeError& e) {
+      throw RuntimeError("module '" + name_ + "': " + e.what());
+    }
   }
 
   // One step is a load increment to t + dt, bisected where Newton does not converge.

@@ -1,5 +1,7 @@
 #include "solid_tlsph/static_equilibrium.hpp"
 
+#include "core/error.hpp"
+
 namespace cosph {
 
 template <int D>
@@ -34,16 +36,33 @@ NewtonOutcome StaticEquilibrium<D>::solve(double t_start, double t, std::vector<
       if (dof_[k] >= 0) r[dof_[k]] = force_[k / D][static_cast<int>(k % D)];
     return scale;
   };
-  bool first = true;
-  const auto tangent = [&](const Eigen::VectorXd&) {
-    body.tangents(first ? t_start : t, C_, loaded_, L_);
+  // The first tangent a solve assembles itself is at the start (the callback follows the residual
+  // of x); on a kept factorisation the first one it assembles is a refresh, at the load of t.
+  bool first = !solver_.has_factorisation();
+  const auto tangent = [&](const Eigen::VectorXd& y) {
+    tangent_point_.u = trial;
+    scatter(y, tangent_point_.u);
+    tangent_point_.force_time = t;
+    tangent_point_.tangent_time = first ? t_start : t;
     first = false;
+    body.tangents(tangent_point_.tangent_time, C_, loaded_, L_);
     return assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_, unknowns_,
                                body.control);
   };
   const NewtonOutcome outcome = solver_.solve(x, residual, tangent, settings);
   scatter(x, u);
   return outcome;
+}
+
+template <int D>
+void StaticEquilibrium<D>::restore_tangent(const TangentPoint& point, const Body& body) {
+  force_.resize(point.u.size());
+  body.force(point.force_time, point.u, force_);  // F at the point, for the tangent call
+  body.tangents(point.tangent_time, C_, loaded_, L_);
+  if (!solver_.adopt_tangent(assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_,
+                                                 unknowns_, body.control)))
+    throw RuntimeError("the checkpoint's steady-state tangent does not factorise");
+  tangent_point_ = point;
 }
 
 template class StaticEquilibrium<2>;

@@ -69,9 +69,26 @@ class StaticEquilibrium {
   // tangent is that equilibrium's own, at the load of t_start: a stable equilibrium's tangent is
   // positive definite, where the tangent of the start under the new load need not be (a follower
   // pressure's load stiffness at full load on an unstressed body: Land's ventricle at u = 0 and
-  // 10 kPa). Later tangents take the load of t. On failure u holds the last accepted iterate.
+  // 10 kPa). Later tangents take the load of t. A solve that follows a converged one starts on
+  // the factorisation that solve left (newton_solver.hpp), a tangent of the last equilibrium's
+  // neighbourhood, instead of assembling the first one. On failure u holds the last accepted
+  // iterate.
   NewtonOutcome solve(double t_start, double t, std::vector<Vec<D>>& u, const Body& body,
                       const NewtonSettings& settings);
+
+  // Where the factorisation that the next solve starts on was taken: the displacements of the
+  // body, the load time of its force call and the load time of its tangent. A checkpoint keeps it
+  // so that a restart starts on the same factorisation, bit for bit, as the run it continues.
+  struct TangentPoint {
+    std::vector<Vec<D>> u;
+    double force_time = 0.0, tangent_time = 0.0;
+  };
+  const TangentPoint* kept_tangent() const {
+    return solver_.has_factorisation() ? &tangent_point_ : nullptr;
+  }
+  // Assembles and factorises the tangent at a point that kept_tangent() gave. Throws
+  // RuntimeError where it does not factorise.
+  void restore_tangent(const TangentPoint& point, const Body& body);
 
   long long unknowns() const { return unknowns_; }
   std::size_t tangent_blocks() const { return pattern_.column.size(); }
@@ -90,6 +107,7 @@ class StaticEquilibrium {
   std::vector<Index> loaded_;
   std::vector<ForceTangent<D>> L_;
   std::vector<Vec<D>> force_;
+  TangentPoint tangent_point_;
 };
 
 }  // namespace cosph
