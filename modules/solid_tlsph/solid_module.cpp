@@ -960,6 +960,10 @@ class SolidModule final : public StaticBodyModule<D> {
     } catch (const RuntimeError& e) {
       throw RuntimeError("module '" + name_ + "': " + e.what());
     }
+    // The tangent's force call set F, P and the active tension of its own point and load time;
+    // those of the checkpoint's state come back.
+    std::vector<Vec<D>> force(X_.size());
+    static_force(time_, particles_.vector("displacement"), force);
   }
 
   // One step is a load increment to t + dt, bisected where Newton does not converge.
