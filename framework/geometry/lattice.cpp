@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/parallel.hpp"
 
@@ -65,6 +66,34 @@ double dual_cell_depth(const Shape<D>& shape, const Vec<D>& x, const Vec<D>& dir
     if (contains_vertex<D>(shape, x + (sub_point_offset(s) * spacing) * direction, spacing))
       ++inside;
   return static_cast<double>(inside) / kSubPoints * spacing;
+}
+
+template <int D>
+CellMoments<D> cell_moments(const Shape<D>& shape, const Vec<D>& x, double spacing,
+                            LatticePlacement placement) {
+  const double sub_cell = spacing / kSubPoints;
+  const Mat<D> sub_cell_covariance = (sub_cell * sub_cell / 12.0) * Mat<D>::Identity();
+  if (placement != LatticePlacement::vertex)
+    return {Vec<D>::Zero(), (spacing * spacing / 12.0) * Mat<D>::Identity()};
+  int total = 1;
+  for (int a = 0; a < D; ++a) total *= kSubPoints;
+  std::vector<Vec<D>> inside;
+  for (int s = 0; s < total; ++s) {
+    Vec<D> offset;
+    int rest = s;
+    for (int a = 0; a < D; ++a, rest /= kSubPoints)
+      offset[a] = sub_point_offset(rest % kSubPoints) * spacing;
+    if (shape.contains(x + offset)) inside.push_back(offset);
+  }
+  if (inside.empty())
+    throw std::invalid_argument("cell moments: the dual cell of a site lies outside the shape");
+  Vec<D> centroid = Vec<D>::Zero();
+  for (const Vec<D>& o : inside) centroid += o;
+  centroid /= static_cast<double>(inside.size());
+  Mat<D> covariance = sub_cell_covariance;
+  for (const Vec<D>& o : inside)
+    covariance += (o - centroid) * (o - centroid).transpose() / static_cast<double>(inside.size());
+  return {centroid, covariance};
 }
 
 template <int D>
@@ -156,6 +185,8 @@ ParticleCloud<D> lattice_fill(const Shape<D>& shape, double spacing, const Vec<D
 
 template double dual_cell_depth<2>(const Shape<2>&, const Vec<2>&, const Vec<2>&, double);
 template double dual_cell_depth<3>(const Shape<3>&, const Vec<3>&, const Vec<3>&, double);
+template CellMoments<2> cell_moments<2>(const Shape<2>&, const Vec<2>&, double, LatticePlacement);
+template CellMoments<3> cell_moments<3>(const Shape<3>&, const Vec<3>&, double, LatticePlacement);
 template ParticleCloud<2> lattice_fill<2>(const Shape<2>&, double, const Vec<2>&, LatticePlacement);
 template ParticleCloud<3> lattice_fill<3>(const Shape<3>&, double, const Vec<3>&, LatticePlacement);
 

@@ -50,4 +50,19 @@ template <int D>
 double dual_cell_depth(const Shape<D>& shape, const Vec<D>& x, const Vec<D>& direction,
                        double spacing);
 
+// The centroid (relative to the site) and the covariance of the part of a site's cell that the
+// shape contains: the first two moments that a quadrature over the cell must reproduce to
+// integrate quadratic fields exactly. For cell placement the whole cell [x - spacing/2,
+// x + spacing/2]^D (centroid 0, covariance spacing^2 / 12 I); for vertex placement its dual cell,
+// measured on the 4^D sub-points that measure its volume, each standing for its sub-cell (whose
+// own covariance is added): exact wherever lattice_fill's volume is.
+template <int D>
+struct CellMoments {
+  Vec<D> centroid;
+  Mat<D> covariance;
+};
+template <int D>
+CellMoments<D> cell_moments(const Shape<D>& shape, const Vec<D>& x, double spacing,
+                            LatticePlacement placement);
+
 }  // namespace cosph

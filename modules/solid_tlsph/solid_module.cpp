@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -46,6 +47,7 @@ class SolidModule final : public StaticBodyModule<D> {
       initial_velocity_.push_back(
           parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));
     if (spec_.has_steady_state()) check_steady_state_spec();
+    if (dual_cell_quadrature()) check_energy_quadrature_spec();
   }
 
   ModuleInfo info() const override {
@@ -64,6 +66,7 @@ class SolidModule final : public StaticBodyModule<D> {
     f.push_back("material " + material_.name());
     f.push_back("total-Lagrangian SPH, kernel " + kernel_name(kernel_.type()) +
                 ", corrected gradients");
+    if (dual_cell_quadrature()) f.push_back("energy integrated over the dual cells");
     if (spec_.gradient_correction() == "quadratic")
       f.push_back("quadratic gradient correction (" + std::to_string(pairs_.quadratic_particles()) +
                   " of " + std::to_string(X_.size()) + " particles)");
@@ -133,13 +136,14 @@ class SolidModule final : public StaticBodyModule<D> {
                                         spec_.gradient_correction() == "quadratic"
                                             ? GradientCorrection::quadratic
                                             : GradientCorrection::linear,
-                                        pair_hourglass());
+                                        pair_hourglass(), {.wanted = dual_cell_quadrature()});
     } catch (const RuntimeError& e) {
       throw RuntimeError("module '" + name_ + "': " + e.what());
     }
     if (fit_residual_hourglass())
       fit_control_.emplace(X_, volume, pairs_, kernel_,
                            spec_.hourglass_control().coefficient() * material_.shear_modulus());
+    if (dual_cell_quadrature()) build_energy_quadrature();
     F_.assign(n, Mat<D>::Identity());
     P_.assign(n, Mat<D>::Zero());
     if (spec_.has_artificial_viscosity()) {
@@ -225,7 +229,7 @@ class SolidModule final : public StaticBodyModule<D> {
         if (stress) particles_.matrix("stress")[i] = sigma;
         if (vm) particles_.scalar("von_mises")[i] = von_mises(sigma, out_of_plane_stress(i));
       }
-      if (energy) particles_.scalar("strain_energy")[i] = material_.energy(F_[i], frame);
+      if (energy) particles_.scalar("strain_energy")[i] = strain_energy(i, frame);
       if (fibre) {
         const Mat<D> E = 0.5 * (F_[i].transpose() * F_[i] - Mat<D>::Identity());
         const Mat<D> local = frame.transpose() * E * frame;
@@ -467,6 +471,50 @@ class SolidModule final : public StaticBodyModule<D> {
     return P;
   }
 
+  // The dual cell's points need the quadratic fit's curvature and a cell the lattice defines.
+  void check_energy_quadrature_spec() const {
+    const std::string key = key_ + ".energy_quadrature";
+    if (spec_.gradient_correction() != "quadratic")
+      throw ConfigError(key,
+                        "dual_cell needs gradient_correction: quadratic (F at the cell's "
+                        "points comes from the quadratic fit)");
+    const auto& body = spec_.body();
+    if (!body.has_shape() || lattice_placement(body) == LatticePlacement::conforming ||
+        body.perturbation() != 0.0)
+      throw ConfigError(key,
+                        "dual_cell needs a body filled on an unperturbed lattice (placement "
+                        "cell or vertex): the lattice defines the particles' cells");
+  }
+
+  // W per unit reference volume: at the particle, or the mean over its cell's points.
+  double strain_energy(std::size_t i, const Mat<D>& frame) const {
+    if (quadrature_.offset.empty()) return material_.energy(F_[i], frame);
+    double sum = 0.0;
+    for (const Mat<D>& F_q : Fq_[i]) sum += material_.energy(F_q, frame);
+    return sum / EnergyQuadrature<D>::points;
+  }
+
+  bool dual_cell_quadrature() const { return spec_.energy_quadrature() == "dual_cell"; }
+
+  // The energy's points in every particle's cell (scene key energy_quadrature).
+  void build_energy_quadrature() {
+    if (!body_shape_) body_shape_ = build_shape<D>(spec_.body().shape(), key_ + ".body.shape");
+    const LatticePlacement placement = lattice_placement(spec_.body());
+    const double spacing = spec_.body().spacing();
+    quadrature_.offset.resize(X_.size());
+    parallel_for_each_index(X_.size(), [&](std::size_t i) {
+      const CellMoments<D> cell = cell_moments<D>(*body_shape_, X_[i], spacing, placement);
+      quadrature_.offset[i] = EnergyQuadrature<D>::points_of(cell.centroid, cell.covariance);
+    });
+    Fq_.assign(X_.size(), {});
+    T_.assign(X_.size(), {});
+  }
+
+  Vec<D> stress_divergence(std::size_t i) const {
+    if (quadrature_.offset.empty()) return pair_stress_divergence<D>(pairs_, P_, i);
+    return quadrature_stress_divergence<D>(pairs_, P_, T_, particles_.scalar("volume"), i);
+  }
+
   const Surface<D>& surface() const {
     if (!surface_)
       surface_ = detect_surface<D>(X_, particles_.scalar("volume"), spec_.body().spacing());
@@ -670,7 +718,12 @@ class SolidModule final : public StaticBodyModule<D> {
         [&](std::size_t i) {
           const Mat<D>& F = F_[i] = deformation_gradient<D>(pairs_, u, i);
           const Mat<D> frame = frames_.empty() ? Mat<D>::Identity() : frames_[i];
-          P_[i] = first_piola(i, F, frame);
+          if (quadrature_.offset.empty())
+            P_[i] = first_piola(i, F, frame);
+          else
+            P_[i] = integrate_stress<D>(
+                quadrature_, i, F, deformation_gradient_slopes<D>(pairs_, u, i),
+                [&](const Mat<D>& F_q) { return first_piola(i, F_q, frame); }, T_[i], &Fq_[i]);
           x_[i] = X_[i] + u[i];
           if (viscosity) {
             const double J = F.determinant();
@@ -688,7 +741,7 @@ class SolidModule final : public StaticBodyModule<D> {
     parallel_for_each_index(
         n,
         [&](std::size_t i) {
-          Vec<D> force = pair_stress_divergence<D>(pairs_, P_, i);
+          Vec<D> force = stress_divergence(i);
           if (viscosity) force += artificial_viscosity<D>(pairs_, x_, v, density_, A_, viscous, i);
           if (hourglass) force += hourglass_force<D>(pairs_, X_, x_, F_, stiffness, i);
           if (fit_control_) force += fit_control_->force(i) / volume[i];
@@ -884,6 +937,7 @@ class SolidModule final : public StaticBodyModule<D> {
       return static_force(t, u, f);
     };
     static_body_.control = fit_control_ ? &*fit_control_ : nullptr;
+    static_body_.quadrature = quadrature_.offset.empty() ? nullptr : &quadrature_;
     static_body_.tangents = [this](double t, std::vector<MaterialTangent<D>>& C,
                                    std::vector<Index>& loaded, std::vector<ForceTangent<D>>& L) {
       static_tangents(t, C, loaded, L);
@@ -898,7 +952,7 @@ class SolidModule final : public StaticBodyModule<D> {
     const auto& volume = particles_.scalar("volume");
     parallel_for_each_index(u.size(), [&](std::size_t i) {
       force[i] *= mass[i];
-      internal_force_[i] = volume[i] * pair_stress_divergence<D>(pairs_, P_, i);
+      internal_force_[i] = volume[i] * stress_divergence(i);
     });
     auto free_norm = [&](auto&& component) {
       return std::sqrt(deterministic_sum(u.size(), 0.0, [&](std::size_t i) {
@@ -919,11 +973,14 @@ class SolidModule final : public StaticBodyModule<D> {
   void static_tangents(double t, std::vector<MaterialTangent<D>>& C, std::vector<Index>& loaded,
                        std::vector<ForceTangent<D>>& L) {
     const std::size_t n = X_.size();
-    C.resize(n);
+    const int points = quadrature_.offset.empty() ? 1 : EnergyQuadrature<D>::points;
+    C.resize(n * static_cast<std::size_t>(points));
     parallel_for_each_index(n, [&](std::size_t i) {
       const Mat<D> frame = frames_.empty() ? Mat<D>::Identity() : frames_[i];
-      C[i] = derivative_in_F<D, D * D>(
-          [&](const Mat<D>& F) { return flatten<D>(first_piola(i, F, frame)); }, F_[i]);
+      for (int q = 0; q < points; ++q)
+        C[i * points + q] = derivative_in_F<D, D * D>(
+            [&](const Mat<D>& F) { return flatten<D>(first_piola(i, F, frame)); },
+            points == 1 ? F_[i] : Fq_[i][q]);
     });
     loaded = loaded_particles_;
     L.assign(loaded.size(), ForceTangent<D>::Zero());
@@ -1015,6 +1072,10 @@ class SolidModule final : public StaticBodyModule<D> {
   std::vector<Expression> initial_velocity_;
   std::vector<Vec<D>> X_, x_;
   std::vector<Mat<D>> frames_, F_, P_, A_;  // P: first Piola; A = J F^-T (viscosity)
+  // energy_quadrature: dual_cell only: the points, F there and the stresses' first moments.
+  EnergyQuadrature<D> quadrature_;
+  std::vector<std::array<Mat<D>, EnergyQuadrature<D>::points>> Fq_;
+  std::vector<StressMoments<D>> T_;
   std::vector<double> density_;
   std::vector<char> fibre_undefined_;  // per particle, where the fibre rule is singular; or empty
   const std::vector<double>* active_ = nullptr;  // T_a per particle, when there is one

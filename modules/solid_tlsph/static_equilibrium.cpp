@@ -47,7 +47,7 @@ NewtonOutcome StaticEquilibrium<D>::solve(double t_start, double t, std::vector<
     first = false;
     body.tangents(tangent_point_.tangent_time, C_, loaded_, L_);
     return assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_, unknowns_,
-                               body.control);
+                               body.control, body.quadrature);
   };
   const NewtonOutcome outcome = solver_.solve(x, residual, tangent, settings);
   scatter(x, u);
@@ -60,7 +60,7 @@ void StaticEquilibrium<D>::restore_tangent(const TangentPoint& point, const Body
   body.force(point.force_time, point.u, force_);  // F at the point, for the tangent call
   body.tangents(point.tangent_time, C_, loaded_, L_);
   if (!solver_.adopt_tangent(assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_,
-                                                 unknowns_, body.control)))
+                                                 unknowns_, body.control, body.quadrature)))
     throw RuntimeError("the checkpoint's steady-state tangent does not factorise");
   tangent_point_ = point;
 }

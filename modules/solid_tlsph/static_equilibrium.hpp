@@ -58,6 +58,9 @@ class StaticEquilibrium {
     // A zero-energy control whose force is part of `force`: its constant stiffness joins the
     // tangent (null: none).
     const FitResidualControl<D>* control = nullptr;
+    // Where the energy is integrated over each particle's dual cell: C then holds C at every
+    // quadrature point, point q of particle i at i * points + q (null: C_i at the particles).
+    const EnergyQuadrature<D>* quadrature = nullptr;
   };
 
   // prescribed[i * D + a]: component a of particle i is prescribed at every load.

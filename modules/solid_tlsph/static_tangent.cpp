@@ -16,6 +16,13 @@ Vec<D> coefficient(const ReferencePairs<D>& pairs, std::size_t i, std::size_t sl
   return pairs.gradient[pairs.neighbours.offset[i] + slot - 1];
 }
 
+// The second-derivative coefficients in the same slots: -sum_j h_ij for i itself, h_ik for k.
+template <int D>
+Mat<D> curvature_coefficient(const ReferencePairs<D>& pairs, std::size_t i, std::size_t slot) {
+  if (slot == 0) return -pairs.curvature_sum[i];
+  return pairs.curvature[pairs.neighbours.offset[i] + slot - 1];
+}
+
 template <int D>
 Index node(const ReferencePairs<D>& pairs, std::size_t i, std::size_t slot) {
   return slot == 0 ? static_cast<Index>(i)
@@ -70,61 +77,72 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
                                              const std::vector<Index>& force_tangent_particles,
                                              const std::vector<ForceTangent<D>>& force_tangents,
                                              const std::vector<long long>& dof, long long unknowns,
-                                             const FitResidualControl<D>* control) {
+                                             const FitResidualControl<D>* control,
+                                             const EnergyQuadrature<D>* quadrature) {
   using Block = Mat<D>;
   using Contracted = Eigen::Matrix<double, D * D, D>;
   const NeighbourList& nl = pairs.neighbours;
   const std::size_t n = nl.particle_count();
-
-  // Q_ik = C_i H_ik per slot: Q[(a, b), c] = sum_d C_i[(a, b), (c, d)] c_ik[d].
   std::vector<std::size_t> slot_offset(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) slot_offset[i + 1] = slot_offset[i] + slots(nl, i);
-  std::vector<Contracted> Q(slot_offset[n]);
-  parallel_for_each_index(n, [&](std::size_t i) {
-    for (std::size_t s = 0; s < slots(nl, i); ++s) {
-      const Vec<D> c = coefficient(pairs, i, s);
-      Contracted& q = Q[slot_offset[i] + s];
-      for (int col = 0; col < D; ++col) {
-        Eigen::Matrix<double, D * D, 1> sum = Eigen::Matrix<double, D * D, 1>::Zero();
-        for (int d = 0; d < D; ++d) sum += C[i].col(col * D + d) * c[d];
-        q.col(col) = sum;
-      }
-    }
-  });
   std::vector<long long> own_force(n, -1);
   for (std::size_t m = 0; m < force_tangent_particles.size(); ++m)
     own_force[force_tangent_particles[m]] = static_cast<long long>(m);
-
-  // Row j of K: sum over the particles i whose F depends on u_j (j itself and its neighbours).
   std::vector<Block> K(pattern.column.size(), Block::Zero());
-  parallel_for_each_index(n, [&](std::size_t j) {
-    auto add_particle = [&](std::size_t i, std::size_t slot_of_j) {
-      const Vec<D> c_ij = coefficient(pairs, i, slot_of_j);
-      for (std::size_t s = 0; s < slots(nl, i); ++s) {
-        const Contracted& q = Q[slot_offset[i] + s];
-        Block b = Block::Zero();
-        for (int a = 0; a < D; ++a)
-          for (int bb = 0; bb < D; ++bb) b.row(a) += c_ij[bb] * q.row(a * D + bb);
-        b *= volume[i];
-        if (control) b.diagonal().array() += control->stiffness(i, slot_of_j, s);
-        K[find_column(pattern, j, node(pairs, i, s))] += b;
-      }
+  std::vector<Contracted> Q(slot_offset[n]);
+  const int points = quadrature ? EnergyQuadrature<D>::points : 1;
+  const double weight = 1.0 / points;
+  for (int q = 0; q < points; ++q) {
+    // The coefficients of F at point q of particle i's dual cell (at the particle itself without
+    // a quadrature): c_ik + h_ik d_q.
+    auto coefficient_at = [&](std::size_t i, std::size_t slot) -> Vec<D> {
+      if (!quadrature) return coefficient(pairs, i, slot);
+      return coefficient(pairs, i, slot) +
+             curvature_coefficient(pairs, i, slot) * quadrature->offset[i][q];
     };
-    add_particle(j, 0);
-    // Neighbour i's slot of j: the reverse pair's place in i's list (slot 0 is i itself).
-    for (std::size_t k = nl.offset[j]; k < nl.offset[j + 1]; ++k)
-      add_particle(nl.index[k], pairs.reverse_pair[k] - nl.offset[nl.index[k]] + 1);
-    if (own_force[j] >= 0) {
-      const ForceTangent<D>& L = force_tangents[static_cast<std::size_t>(own_force[j])];
-      for (std::size_t s = 0; s < slots(nl, j); ++s) {
-        const Vec<D> c = coefficient(pairs, j, s);
-        Block b = Block::Zero();
-        for (int col = 0; col < D; ++col)
-          for (int d = 0; d < D; ++d) b.col(col) += L.col(col * D + d) * c[d];
-        K[find_column(pattern, j, node(pairs, j, s))] -= b;
+    // Q_ik = C_i H_ik per slot: Q[(a, b), c] = sum_d C_i[(a, b), (c, d)] c_ik[d].
+    parallel_for_each_index(n, [&](std::size_t i) {
+      const MaterialTangent<D>& Ci = C[i * points + q];
+      for (std::size_t s = 0; s < slots(nl, i); ++s) {
+        const Vec<D> c = coefficient_at(i, s);
+        Contracted& out = Q[slot_offset[i] + s];
+        for (int col = 0; col < D; ++col) {
+          Eigen::Matrix<double, D * D, 1> sum = Eigen::Matrix<double, D * D, 1>::Zero();
+          for (int d = 0; d < D; ++d) sum += Ci.col(col * D + d) * c[d];
+          out.col(col) = sum;
+        }
       }
-    }
-  });
+    });
+    // Row j of K: sum over the particles i whose F depends on u_j (j itself and its neighbours).
+    parallel_for_each_index(n, [&](std::size_t j) {
+      auto add_particle = [&](std::size_t i, std::size_t slot_of_j) {
+        const Vec<D> c_ij = coefficient_at(i, slot_of_j);
+        for (std::size_t s = 0; s < slots(nl, i); ++s) {
+          const Contracted& Qs = Q[slot_offset[i] + s];
+          Block b = Block::Zero();
+          for (int a = 0; a < D; ++a)
+            for (int bb = 0; bb < D; ++bb) b.row(a) += c_ij[bb] * Qs.row(a * D + bb);
+          b *= weight * volume[i];
+          if (control && q == 0) b.diagonal().array() += control->stiffness(i, slot_of_j, s);
+          K[find_column(pattern, j, node(pairs, i, s))] += b;
+        }
+      };
+      add_particle(j, 0);
+      // Neighbour i's slot of j: the reverse pair's place in i's list (slot 0 is i itself).
+      for (std::size_t k = nl.offset[j]; k < nl.offset[j + 1]; ++k)
+        add_particle(nl.index[k], pairs.reverse_pair[k] - nl.offset[nl.index[k]] + 1);
+      if (q == 0 && own_force[j] >= 0) {
+        const ForceTangent<D>& L = force_tangents[static_cast<std::size_t>(own_force[j])];
+        for (std::size_t s = 0; s < slots(nl, j); ++s) {
+          const Vec<D> c = coefficient(pairs, j, s);
+          Block b = Block::Zero();
+          for (int col = 0; col < D; ++col)
+            for (int d = 0; d < D; ++d) b.col(col) += L.col(col * D + d) * c[d];
+          K[find_column(pattern, j, node(pairs, j, s))] -= b;
+        }
+      }
+    });
+  }
 
   // The lower triangle of the symmetric part on the free unknowns, in compressed column storage
   // (what the Cholesky factorisation reads). Column dof(j, a) holds rows dof(k, c) >= dof(j, a)
@@ -179,7 +197,7 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
       const ReferencePairs<D>&, const TangentPattern&, const std::vector<double>&,   \
       const std::vector<MaterialTangent<D>>&, const std::vector<Index>&,             \
       const std::vector<ForceTangent<D>>&, const std::vector<long long>&, long long, \
-      const FitResidualControl<D>*);
+      const FitResidualControl<D>*, const EnergyQuadrature<D>*);
 COSPH_INSTANTIATE_STATIC_TANGENT(2)
 COSPH_INSTANTIATE_STATIC_TANGENT(3)
 

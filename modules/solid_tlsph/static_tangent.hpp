@@ -56,6 +56,7 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
                                              const std::vector<Index>& force_tangent_particles,
                                              const std::vector<ForceTangent<D>>& force_tangents,
                                              const std::vector<long long>& dof, long long unknowns,
-                                             const FitResidualControl<D>* control = nullptr);
+                                             const FitResidualControl<D>* control = nullptr,
+                                             const EnergyQuadrature<D>* quadrature = nullptr);
 
 }  // namespace cosph

@@ -19,8 +19,8 @@ namespace {
 // reliably or the fit would stiffen the operator too much: then the linear correction stays.
 template <int D>
 bool quadratic_gradients(const std::vector<Vec<D>>& X, const NeighbourList& nl,
-                         const std::vector<double>& omega, double h, std::size_t i,
-                         std::vector<Vec<D>>& g) {
+                         const std::vector<double>& omega, double h, double max_amplification,
+                         std::size_t i, std::vector<Vec<D>>& g, std::vector<Mat<D>>* curvature) {
   constexpr int m = D + D * (D + 1) / 2;
   using Basis = Eigen::Matrix<double, m, 1>;
   auto basis = [&](const Vec<D>& X_ij) {
@@ -52,18 +52,30 @@ bool quadratic_gradients(const std::vector<Vec<D>>& X, const NeighbourList& nl,
   // positions jittered by 0.15 dp) and a face particle's 3.7 in 3D; edges (3D) 6.2-6.4, corners
   // 6.9 (2D) and 8.4 (3D). Edges and corners keep the linear correction: the rubber gate's stable
   // step grows by a fifth, its swing and the oscillating plate's period stay (docs/ARCHITECTURE).
-  constexpr double kMaxAmplification = 6.0;
   const std::size_t begin = nl.offset[i], count = nl.offset[i + 1] - begin;
   std::vector<Vec<D>> fitted(count);
+  std::vector<Mat<D>> second(curvature ? count : 0);
   double linear = 0.0, quadratic = 0.0;
   for (std::size_t k = 0; k < count; ++k) {
     const Basis c = inverse * basis(X[nl.index[begin + k]] - X[i]);
     fitted[k] = (omega[begin + k] / h) * c.template head<D>();
     linear += g[begin + k].squaredNorm();
     quadratic += fitted[k].squaredNorm();
+    if (!curvature) continue;
+    // The fit's term for s_a s_b is (1/2) H_ab h^2 on the diagonal and H_ab h^2 off it.
+    const double scale = omega[begin + k] / (h * h);
+    int row = D;
+    for (int a = 0; a < D; ++a)
+      for (int b = a; b < D; ++b, ++row) {
+        const double value = scale * c[row] * (a == b ? 2.0 : 1.0);
+        second[k](a, b) = second[k](b, a) = value;
+      }
   }
-  if (!(quadratic <= kMaxAmplification * linear)) return false;
+  if (!(quadratic <= max_amplification * linear)) return false;
   std::copy(fitted.begin(), fitted.end(), g.begin() + static_cast<std::ptrdiff_t>(begin));
+  if (curvature)
+    std::copy(second.begin(), second.end(),
+              curvature->begin() + static_cast<std::ptrdiff_t>(begin));
   return true;
 }
 
@@ -103,7 +115,8 @@ void reverse_gradients(const NeighbourList& nl, const std::vector<double>& volum
 template <int D>
 ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
                                         const std::vector<double>& volume, const Kernel& kernel,
-                                        GradientCorrection correction, bool hourglass) {
+                                        GradientCorrection correction, bool hourglass,
+                                        const CurvatureOptions& curvature) {
   ReferencePairs<D> pairs;
   const Domain<D> free_space;  // a solid body is never periodic
   pairs.neighbours = build_inner_list<D>(X, kernel.support_radius(), free_space);
@@ -116,6 +129,10 @@ ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
   std::vector<double> omega(nl.pair_count());
   if (hourglass) pairs.hourglass_weight.resize(nl.pair_count());
   std::vector<char> quadratic(X.size(), 0);
+  if (curvature.wanted) {
+    pairs.curvature.assign(nl.pair_count(), Mat<D>::Zero());
+    pairs.curvature_sum.assign(X.size(), Mat<D>::Zero());
+  }
   parallel_for_each_index(X.size(), [&](std::size_t i) {
     for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
       const Index j = nl.index[k];
@@ -127,10 +144,17 @@ ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
         pairs.hourglass_weight[k] = volume[j] * kernel.value(distance) / (distance * distance);
     }
     if (correction == GradientCorrection::quadratic)
-      quadratic[i] = quadratic_gradients<D>(X, nl, omega, h, i, pairs.gradient);
+      quadratic[i] =
+          quadratic_gradients<D>(X, nl, omega, h, curvature.max_amplification, i, pairs.gradient,
+                                 curvature.wanted ? &pairs.curvature : nullptr);
     Vec<D> sum = Vec<D>::Zero();
     for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) sum += pairs.gradient[k];
     pairs.gradient_sum[i] = sum;
+    if (curvature.wanted) {
+      Mat<D> second = Mat<D>::Zero();
+      for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) second += pairs.curvature[k];
+      pairs.curvature_sum[i] = second;
+    }
   });
   pairs.quadratic = std::move(quadratic);
   pairs.reverse_pair = reverse_pairs(nl);
@@ -189,9 +213,9 @@ Vec<D> hourglass_force(const ReferencePairs<D>& pairs, const std::vector<Vec<D>>
 }
 
 #define COSPH_INSTANTIATE_TLSPH(D)                                                                \
-  template ReferencePairs<D> build_reference_pairs<D>(const std::vector<Vec<D>>&,                 \
-                                                      const std::vector<double>&, const Kernel&,  \
-                                                      GradientCorrection, bool);                  \
+  template ReferencePairs<D> build_reference_pairs<D>(                                            \
+      const std::vector<Vec<D>>&, const std::vector<double>&, const Kernel&, GradientCorrection,  \
+      bool, const CurvatureOptions&);                                                             \
   template void deformation_gradients<D>(const ReferencePairs<D>&, const std::vector<Vec<D>>&,    \
                                          std::vector<Mat<D>>&);                                   \
   template Vec<D> artificial_viscosity<D>(const ReferencePairs<D>&, const std::vector<Vec<D>>&,   \

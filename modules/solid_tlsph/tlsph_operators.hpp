@@ -27,7 +27,10 @@
 // some direction, e.g. a body one or two particles thick) keeps the linear correction.
 #pragma once
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <vector>
 
 #include "core/types.hpp"
@@ -51,6 +54,46 @@ struct ReferencePairs {
   }
   // Only with hourglass control: V_j W_ij / |X_ij|^2 per pair.
   std::vector<double> hourglass_weight;
+  // Only where asked (CurvatureOptions): the quadratic fit's second-derivative coefficients h_ij,
+  // symmetric, so that the fitted d2u/dX_b dX_c at particle i is sum_j (u_j - u_i) h_ij(b, c)
+  // (zero where the linear correction holds), and their sums over j.
+  std::vector<Mat<D>> curvature;
+  std::vector<Mat<D>> curvature_sum;
+};
+
+// The quadratic fit keeps its gradient coefficients where they amplify sum_j |g_ij|^2 at most
+// this many times over the linear correction's: the explicit step goes as 1 / |g| (edges and
+// corners of a lattice body exceed it; see quadratic_gradients).
+inline constexpr double kExplicitMaxAmplification = 6.0;
+
+struct CurvatureOptions {
+  bool wanted = false;  // keep the fit's second-derivative coefficients
+  double max_amplification = kExplicitMaxAmplification;
+};
+
+// Where a particle's strain energy is sampled when it is integrated over the particle's dual cell
+// instead of taken at the particle: 2D points per particle, offsets d_q = X_q - X_i, equal weights
+// 1 / (2D); F at a point is the quadratic fit's F_i + H_i d_q (the pairs' curvature).
+template <int D>
+struct EnergyQuadrature {
+  static constexpr int points = 2 * D;
+  using Points = std::array<Vec<D>, points>;
+  std::vector<Points> offset;
+
+  // The points c +- sqrt(D lambda_k) e_k of a cell with centroid c (relative to the particle) and
+  // covariance sum_k lambda_k e_k e_k^T: with equal weights they reproduce both moments, so they
+  // integrate quadratic fields over the cell exactly (a cube's points are its face centres).
+  static Points points_of(const Vec<D>& centroid, const Mat<D>& covariance) {
+    const Eigen::SelfAdjointEigenSolver<Mat<D>> eigen(covariance);
+    Points p;
+    for (int k = 0; k < D; ++k) {
+      const Vec<D> axis =
+          std::sqrt(D * std::max(eigen.eigenvalues()[k], 0.0)) * eigen.eigenvectors().col(k);
+      p[2 * k] = centroid + axis;
+      p[2 * k + 1] = centroid - axis;
+    }
+    return p;
+  }
 };
 
 // Builds the pairs. Throws RuntimeError naming the particle whose linear correction matrix is
@@ -58,7 +101,8 @@ struct ReferencePairs {
 template <int D>
 ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
                                         const std::vector<double>& volume, const Kernel& kernel,
-                                        GradientCorrection correction, bool hourglass);
+                                        GradientCorrection correction, bool hourglass,
+                                        const CurvatureOptions& curvature = {});
 
 // F_i = I + sum_j (u_j - u_i) g_ij^T from the displacements, for one particle (inline: the
 // solid fuses it with the stress in one loop) and for all.
@@ -85,6 +129,69 @@ Vec<D> pair_stress_divergence(const ReferencePairs<D>& pairs, const std::vector<
   const std::size_t start = pairs.neighbours.offset[i];
   Vec<D> sum = P[i] * pairs.gradient_sum[i];
   for (std::size_t k = 0; k < nb.size(); ++k) sum.noalias() += P[nb[k]] * pairs.reverse[start + k];
+  return sum;
+}
+
+// The slopes of F across particle i's dual cell from the quadratic fit (its curvature
+// coefficients): F(X_i + d) = F_i + sum_c d_c S_c with S_c = sum_j (u_j - u_i) h_ij(:, c)^T; zero
+// where the linear correction holds.
+template <int D>
+using GradientSlopes = std::array<Mat<D>, D>;
+template <int D>
+GradientSlopes<D> deformation_gradient_slopes(const ReferencePairs<D>& pairs,
+                                              const std::vector<Vec<D>>& u, std::size_t i) {
+  const auto& nl = pairs.neighbours;
+  GradientSlopes<D> S;
+  for (auto& s : S) s.setZero();
+  for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
+    const Vec<D> du = u[nl.index[k]] - u[i];
+    for (int c = 0; c < D; ++c) S[c].noalias() += du * pairs.curvature[k].col(c).transpose();
+  }
+  return S;
+}
+
+// The energy of particle i integrated over its dual cell: P_iq = stress(F_iq) at the quadrature
+// points F_iq = F_i + sum_c d_qc S_c, returned as their mean P_i = sum_q w_q P_iq and first
+// moments T_i[c] = sum_q w_q d_qc P_iq, which is all the stress divergence needs; F_iq are kept
+// in `Fq` (for the tangent) where given.
+template <int D>
+using StressMoments = std::array<Mat<D>, D>;
+template <int D, typename Stress>
+Mat<D> integrate_stress(const EnergyQuadrature<D>& quadrature, std::size_t i, const Mat<D>& F,
+                        const GradientSlopes<D>& S, const Stress& stress, StressMoments<D>& T,
+                        std::array<Mat<D>, EnergyQuadrature<D>::points>* Fq = nullptr) {
+  constexpr double w = 1.0 / EnergyQuadrature<D>::points;
+  Mat<D> mean = Mat<D>::Zero();
+  for (auto& t : T) t.setZero();
+  for (int q = 0; q < EnergyQuadrature<D>::points; ++q) {
+    const Vec<D>& d = quadrature.offset[i][q];
+    Mat<D> F_q = F;
+    for (int c = 0; c < D; ++c) F_q.noalias() += d[c] * S[c];
+    if (Fq) (*Fq)[q] = F_q;
+    const Mat<D> P_q = stress(F_q);
+    mean.noalias() += w * P_q;
+    for (int c = 0; c < D; ++c) T[c].noalias() += (w * d[c]) * P_q;
+  }
+  return mean;
+}
+
+// The exact gradient of the dual-cell energy sum_i V_i sum_q w_q Psi(F_iq), with F_iq linear in u
+// through g_ij + h_ij d_q: pair_stress_divergence of the mean stresses plus the moments' share,
+//   sum_c T_i[c] sum_j h_ij(:, c) - sum_j (V_j / V_i) sum_c T_j[c] h_ji(:, c).
+template <int D>
+Vec<D> quadrature_stress_divergence(const ReferencePairs<D>& pairs, const std::vector<Mat<D>>& P,
+                                    const std::vector<StressMoments<D>>& T,
+                                    const std::vector<double>& volume, std::size_t i) {
+  const auto& nl = pairs.neighbours;
+  Vec<D> sum = pair_stress_divergence<D>(pairs, P, i);
+  for (int c = 0; c < D; ++c) sum.noalias() += T[i][c] * pairs.curvature_sum[i].col(c);
+  for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
+    const Index j = nl.index[k];
+    const Mat<D>& h = pairs.curvature[pairs.reverse_pair[k]];
+    Vec<D> share = Vec<D>::Zero();
+    for (int c = 0; c < D; ++c) share.noalias() += T[j][c] * h.col(c);
+    sum.noalias() -= (volume[j] / volume[i]) * share;
+  }
   return sum;
 }
 

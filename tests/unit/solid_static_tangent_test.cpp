@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <array>
 #include <optional>
 #include <random>
 
@@ -30,16 +31,40 @@ struct Problem {
   long long unknowns = 0;
   // The hourglass control, where tested; mutable: force() refreshes its residual storage.
   mutable std::optional<FitResidualControl<D>> control;
+  // The dual-cell energy quadrature, where tested (empty: the energy at the particles).
+  EnergyQuadrature<D> quadrature;
+
+  // P_i at the particles, or the quadrature's mean stresses and moments (and F at its points).
+  std::vector<Mat<D>> stresses(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
+                               std::vector<StressMoments<D>>& T,
+                               std::vector<std::array<Mat<D>, 2 * D>>& Fq) const {
+    const std::size_t n = u.size();
+    std::vector<Mat<D>> P(n);
+    T.resize(n);
+    Fq.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      P[i] = quadrature.offset.empty()
+                 ? material.stress(F[i], Mat<D>::Identity())
+                 : integrate_stress<D>(
+                       quadrature, i, F[i], deformation_gradient_slopes<D>(body.pairs, u, i),
+                       [&](const Mat<D>& G) { return material.stress(G, Mat<D>::Identity()); },
+                       T[i], &Fq[i]);
+    return P;
+  }
 
   // Net force on every particle: V_i (stress divergence) minus p J F^-T N dA.
   std::vector<Vec<D>> force(const std::vector<Vec<D>>& u) const {
     const std::size_t n = u.size();
-    std::vector<Mat<D>> F(n), P(n);
+    std::vector<Mat<D>> F(n);
     deformation_gradients<D>(body.pairs, u, F);
-    for (std::size_t i = 0; i < n; ++i) P[i] = material.stress(F[i], Mat<D>::Identity());
+    std::vector<StressMoments<D>> T;
+    std::vector<std::array<Mat<D>, 2 * D>> Fq;
+    const std::vector<Mat<D>> P = stresses(u, F, T, Fq);
     std::vector<Vec<D>> f(n);
     for (std::size_t i = 0; i < n; ++i)
-      f[i] = body.V[i] * pair_stress_divergence<D>(body.pairs, P, i);
+      f[i] = body.V[i] * (quadrature.offset.empty()
+                              ? pair_stress_divergence<D>(body.pairs, P, i)
+                              : quadrature_stress_divergence<D>(body.pairs, P, T, body.V, i));
     for (std::size_t k = 0; k < loaded.size(); ++k) {
       const Mat<D>& Fi = F[loaded[k]];
       f[loaded[k]] -= pressure * Fi.determinant() * (Fi.inverse().transpose() * area[k]);
@@ -61,7 +86,8 @@ proto::MaterialSpec neo_hookean() {
 }
 
 template <int D>
-Problem<D> make_problem(GradientCorrection correction, unsigned seed, bool control) {
+Problem<D> make_problem(GradientCorrection correction, unsigned seed, bool control,
+                        bool quadrature) {
   std::array<int, D> n;
   n.fill(4);
   n[0] = 6;
@@ -77,9 +103,24 @@ Problem<D> make_problem(GradientCorrection correction, unsigned seed, bool contr
                0.0,
                {},
                0,
+               {},
                {}};
   // kappa mu at half of E: the control's stiffness comparable to the material's.
   if (control) p.control.emplace(p.body.X, p.body.V, p.body.pairs, p.body.kernel, 5e5);
+  if (quadrature) {  // the curvature, and cells of random centroids and covariances
+    p.body.pairs = build_reference_pairs<D>(p.body.X, p.body.V, p.body.kernel, correction, false,
+                                            {.wanted = true});
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    for (std::size_t i = 0; i < p.body.X.size(); ++i) {
+      Vec<D> c;
+      Mat<D> M;
+      for (int a = 0; a < D; ++a) {
+        c[a] = 0.2 * kTestSpacing * unit(rng);
+        for (int b = 0; b < D; ++b) M(a, b) = 0.3 * kTestSpacing * unit(rng);
+      }
+      p.quadrature.offset.push_back(EnergyQuadrature<D>::points_of(c, M * M.transpose()));
+    }
+  }
   const std::size_t count = p.body.X.size();
   p.dof.assign(count * D, 0);
   for (std::size_t i = 0; i < count; ++i) {
@@ -101,8 +142,9 @@ Problem<D> make_problem(GradientCorrection correction, unsigned seed, bool contr
 }
 
 template <int D>
-void check_tangent(GradientCorrection correction, unsigned seed, bool control = false) {
-  const Problem<D> p = make_problem<D>(correction, seed, control);
+void check_tangent(GradientCorrection correction, unsigned seed, bool control = false,
+                   bool quadrature = false) {
+  const Problem<D> p = make_problem<D>(correction, seed, control, quadrature);
   const std::size_t n = p.body.X.size();
   std::mt19937 rng(seed + 7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -113,11 +155,16 @@ void check_tangent(GradientCorrection correction, unsigned seed, bool control = 
 
   std::vector<Mat<D>> F(n);
   deformation_gradients<D>(p.body.pairs, u, F);
-  std::vector<MaterialTangent<D>> C(n);
+  std::vector<StressMoments<D>> T;
+  std::vector<std::array<Mat<D>, 2 * D>> Fq;
+  p.stresses(u, F, T, Fq);
+  const int points = quadrature ? EnergyQuadrature<D>::points : 1;
+  std::vector<MaterialTangent<D>> C(n * points);
   for (std::size_t i = 0; i < n; ++i)
-    C[i] = derivative_in_F<D, D * D>(
-        [&](const Mat<D>& G) { return flatten<D>(p.material.stress(G, Mat<D>::Identity())); },
-        F[i]);
+    for (int q = 0; q < points; ++q)
+      C[i * points + q] = derivative_in_F<D, D * D>(
+          [&](const Mat<D>& G) { return flatten<D>(p.material.stress(G, Mat<D>::Identity())); },
+          quadrature ? Fq[i][q] : F[i]);
   std::vector<ForceTangent<D>> L(p.loaded.size());
   for (std::size_t k = 0; k < p.loaded.size(); ++k)
     L[k] = derivative_in_F<D, D>(
@@ -128,7 +175,7 @@ void check_tangent(GradientCorrection correction, unsigned seed, bool control = 
   const TangentPattern pattern = build_tangent_pattern<D>(p.body.pairs);
   const Eigen::SparseMatrix<double> lower =
       assemble_tangent<D>(p.body.pairs, pattern, p.body.V, C, p.loaded, L, p.dof, p.unknowns,
-                          p.control ? &*p.control : nullptr);
+                          p.control ? &*p.control : nullptr, quadrature ? &p.quadrature : nullptr);
   const Eigen::MatrixXd upper_part = Eigen::MatrixXd(lower).triangularView<Eigen::StrictlyUpper>();
   EXPECT_EQ(upper_part.norm(), 0.0);  // the lower triangle only
   const Eigen::SparseMatrix<double> whole = lower.selfadjointView<Eigen::Lower>();
@@ -153,7 +200,7 @@ void check_tangent(GradientCorrection correction, unsigned seed, bool control = 
   std::cout << D << "D " << (correction == GradientCorrection::linear ? "linear" : "quadratic")
             << ": |K - sym(J_fd)| / |J| = " << error << ", follower asymmetry " << asymmetry << ", "
             << p.unknowns << " unknowns" << (control ? ", with the fit-residual control" : "")
-            << "\n";
+            << (quadrature ? ", dual-cell quadrature" : "") << "\n";
   EXPECT_LT(error, 1e-8);  // measured 0.98e-9 to 6.1e-9 (the differences' own error)
   // The pressure makes J unsymmetric; a test whose J were symmetric could not see the
   // symmetrisation at all.
@@ -175,6 +222,12 @@ TEST(SolidStaticTangent, MatchesTheSymmetricPartOfTheForceJacobian3D) {
 TEST(SolidStaticTangent, IncludesTheFitResidualControl) {
   check_tangent<2>(GradientCorrection::linear, 8, true);
   check_tangent<3>(GradientCorrection::quadratic, 9, true);
+}
+
+// The dual-cell energy quadrature (C at every point, F there through the fit's curvature).
+TEST(SolidStaticTangent, IntegratesTheEnergyOverTheDualCells) {
+  check_tangent<2>(GradientCorrection::quadratic, 10, false, true);
+  check_tangent<3>(GradientCorrection::quadratic, 11, false, true);
 }
 
 }  // namespace

@@ -450,6 +450,22 @@ TEST(SolidScene, BadInputIsRefusedWithItsKeyPath) {
   EXPECT_NE(e.find("modules[0].solid.initial_velocity[0]"), std::string::npos) << e;
 }
 
+// The dual cells' points take F from the quadratic fit, and their cells from the lattice.
+TEST(SolidScene, DualCellEnergyNeedsTheQuadraticFitAndAnUnperturbedLattice) {
+  const std::string dual = "modules[0].solid.energy_quadrature=dual_cell";
+  const std::string quadratic = "modules[0].solid.gradient_correction=quadratic";
+  ASSERT_EQ(scene_error(k2DScene, {dual, quadratic}), "");
+  ASSERT_EQ(scene_error(k2DScene, {dual, quadratic, "modules[0].solid.body.placement=vertex"}), "");
+  std::string e = scene_error(k2DScene, {dual});
+  EXPECT_NE(e.find("modules[0].solid.energy_quadrature"), std::string::npos) << e;
+  EXPECT_NE(e.find("gradient_correction: quadratic"), std::string::npos) << e;
+  e = scene_error(k2DScene, {dual, quadratic, "modules[0].solid.body.perturbation=0.1"});
+  EXPECT_NE(e.find("modules[0].solid.energy_quadrature"), std::string::npos) << e;
+  EXPECT_NE(e.find("unperturbed lattice"), std::string::npos) << e;
+  e = scene_error(k2DScene, {"modules[0].solid.energy_quadrature=gauss"});
+  EXPECT_NE(e.find("modules[0].solid.energy_quadrature"), std::string::npos) << e;
+}
+
 // ---- 7a. Whole scenes conserve momentum ----------------------------------------------------
 
 struct Momenta {
@@ -487,13 +503,14 @@ modules:
       initial_velocity: ["-(y - 0.3) + 0.1 * sin(3 * z)", "x - 0.3", "0.2 * x * y"]
 )yaml";
 
-void check_scene_momentum(const std::string& integrator, double angular_tolerance) {
+void check_scene_momentum(const std::string& integrator, double angular_tolerance,
+                          std::vector<std::string> overrides = {}) {
   RunOptions options;
   options.bench = true;
   options.progress = false;
-  Simulation simulation(
-      load_scene_text(kFreeBlock, "block.yaml", {"modules[0].solid.integrator=" + integrator}),
-      builtin_modules(), options);
+  overrides.push_back("modules[0].solid.integrator=" + integrator);
+  Simulation simulation(load_scene_text(kFreeBlock, "block.yaml", overrides), builtin_modules(),
+                        options);
   simulation.initialize();
   BodyViews views;
   simulation.module(0).bodies(views);
@@ -522,6 +539,13 @@ void check_scene_momentum(const std::string& integrator, double angular_toleranc
 
 TEST(SolidScene, FreeBlockConservesMomentumVerlet) { check_scene_momentum("verlet", 1e-10); }
 TEST(SolidScene, FreeBlockConservesMomentumRk4) { check_scene_momentum("rk4", 1e-6); }
+// The energy integrated over the cells is as invariant as the particles' own (F at every point
+// is the fit's, which rotates with the body).
+TEST(SolidScene, FreeBlockConservesMomentumWithTheDualCellEnergy) {
+  check_scene_momentum("verlet", 1e-10,
+                       {"modules[0].solid.gradient_correction=quadratic",
+                        "modules[0].solid.energy_quadrature=dual_cell"});
+}
 
 // ---- 7b. Nanson follower pressure: uniform compression by p/K ----------------------------------
 // The boundary layer's error is first order in dp / L: the mean J - 1 is -0.75, -0.84, -0.91,
