@@ -512,7 +512,7 @@ class SolidModule final : public StaticBodyModule<D> {
 
   Vec<D> stress_divergence(std::size_t i) const {
     if (quadrature_.offset.empty()) return pair_stress_divergence<D>(pairs_, P_, i);
-    return quadrature_stress_divergence<D>(pairs_, P_, T_, particles_.scalar("volume"), i);
+    return quadrature_stress_divergence<D>(pairs_, P_, T_, i);
   }
 
   const Surface<D>& surface() const {

@@ -102,10 +102,14 @@ template <int D>
 void reverse_gradients(const NeighbourList& nl, const std::vector<double>& volume,
                        ReferencePairs<D>& pairs) {
   pairs.reverse.resize(nl.pair_count());
+  pairs.curvature_reverse.resize(pairs.curvature.size());
   parallel_for_each_index(volume.size(), [&](std::size_t i) {
     for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
       const Index j = nl.index[k];
       pairs.reverse[k] = -(volume[j] / volume[i]) * pairs.gradient[pairs.reverse_pair[k]];
+      if (!pairs.curvature.empty())
+        pairs.curvature_reverse[k] =
+            -(volume[j] / volume[i]) * pairs.curvature[pairs.reverse_pair[k]];
     }
   });
 }

@@ -59,6 +59,7 @@ struct ReferencePairs {
   // (zero where the linear correction holds), and their sums over j.
   std::vector<Mat<D>> curvature;
   std::vector<Mat<D>> curvature_sum;
+  std::vector<Mat<D>> curvature_reverse;  // -(V_j / V_i) h_ji, as `reverse` is for g
 };
 
 // The quadratic fit keeps its gradient coefficients where they amplify sum_j |g_ij|^2 at most
@@ -180,17 +181,14 @@ Mat<D> integrate_stress(const EnergyQuadrature<D>& quadrature, std::size_t i, co
 //   sum_c T_i[c] sum_j h_ij(:, c) - sum_j (V_j / V_i) sum_c T_j[c] h_ji(:, c).
 template <int D>
 Vec<D> quadrature_stress_divergence(const ReferencePairs<D>& pairs, const std::vector<Mat<D>>& P,
-                                    const std::vector<StressMoments<D>>& T,
-                                    const std::vector<double>& volume, std::size_t i) {
+                                    const std::vector<StressMoments<D>>& T, std::size_t i) {
   const auto& nl = pairs.neighbours;
   Vec<D> sum = pair_stress_divergence<D>(pairs, P, i);
   for (int c = 0; c < D; ++c) sum.noalias() += T[i][c] * pairs.curvature_sum[i].col(c);
   for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) {
     const Index j = nl.index[k];
-    const Mat<D>& h = pairs.curvature[pairs.reverse_pair[k]];
-    Vec<D> share = Vec<D>::Zero();
-    for (int c = 0; c < D; ++c) share.noalias() += T[j][c] * h.col(c);
-    sum.noalias() -= (volume[j] / volume[i]) * share;
+    const Mat<D>& h = pairs.curvature_reverse[k];
+    for (int c = 0; c < D; ++c) sum.noalias() += T[j][c] * h.col(c);
   }
   return sum;
 }

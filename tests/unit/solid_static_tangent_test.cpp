@@ -64,7 +64,7 @@ struct Problem {
     for (std::size_t i = 0; i < n; ++i)
       f[i] = body.V[i] * (quadrature.offset.empty()
                               ? pair_stress_divergence<D>(body.pairs, P, i)
-                              : quadrature_stress_divergence<D>(body.pairs, P, T, body.V, i));
+                              : quadrature_stress_divergence<D>(body.pairs, P, T, i));
     for (std::size_t k = 0; k < loaded.size(); ++k) {
       const Mat<D>& Fi = F[loaded[k]];
       f[loaded[k]] -= pressure * Fi.determinant() * (Fi.inverse().transpose() * area[k]);
