@@ -205,7 +205,7 @@ template <int D>
 void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
                        const std::string& key_path, const std::string& scene_directory,
                        const Kernel& kernel, ParticleSet<D>& particles,
-                       std::vector<BoundaryFace<D>>* faces) {
+                       std::vector<BoundaryFace<D>>* faces, std::vector<CellMoments<D>>* cells) {
   const ParticleCloud<D> cloud = build_body<D>(spec, key_path, scene_directory);
   check_body_cloud<D>(scene, cloud, key_path);
   const Domain<D> domain = build_domain<D>(scene);
@@ -217,6 +217,10 @@ void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
     x[k] =
         domain.any_periodic() ? domain.wrap(cloud.positions[order[k]]) : cloud.positions[order[k]];
     V[k] = cloud.volumes[order[k]];
+  }
+  if (cells && !cloud.cells.empty()) {
+    cells->resize(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) (*cells)[k] = cloud.cells[order[k]];
   }
   if (!faces) return;
   std::vector<std::size_t> position_of(order.size());
@@ -236,7 +240,8 @@ void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
                                     const std::string&);                                    \
   template void build_static_body<D>(const proto::Scene&, const proto::BodySpec&,           \
                                      const std::string&, const std::string&, const Kernel&, \
-                                     ParticleSet<D>&, std::vector<BoundaryFace<D>>*);
+                                     ParticleSet<D>&, std::vector<BoundaryFace<D>>*,        \
+                                     std::vector<CellMoments<D>>*);
 COSPH_INSTANTIATE(2)
 COSPH_INSTANTIATE(3)
 

@@ -43,11 +43,13 @@ void check_body_cloud(const proto::Scene& scene, const ParticleCloud<D>& cloud,
 // Particles that never move (diffusion, monodomain): the body's cloud checked against the domain,
 // sorted by cell once for memory locality, wrapped into periodic axes, with the fields "position"
 // and "volume" registered (output) in `particles`. The placement's boundary faces, if it knows
-// any, go to `faces` (indices into `particles`) when it is given.
+// any, go to `faces` (indices into `particles`) when it is given, and so do its particles' cells
+// (in the particles' order; left alone where the placement does not know them).
 template <int D>
 void build_static_body(const proto::Scene& scene, const proto::BodySpec& spec,
                        const std::string& key_path, const std::string& scene_directory,
                        const Kernel& kernel, ParticleSet<D>& particles,
-                       std::vector<BoundaryFace<D>>* faces = nullptr);
+                       std::vector<BoundaryFace<D>>* faces = nullptr,
+                       std::vector<CellMoments<D>>* cells = nullptr);
 
 }  // namespace cosph

@@ -47,7 +47,7 @@ class StaticBodyModule : public Module {
   // Builds the body's particles ("position", "volume"), sorted by cell once.
   void build_body() {
     build_static_body<D>(scene_, body_spec_, key_ + ".body", scene_directory_, kernel_, particles_,
-                         &faces_);
+                         &faces_, &cells_);
   }
 
   // Parses a scene expression; its errors become ConfigErrors at `key`.
@@ -104,6 +104,7 @@ class StaticBodyModule : public Module {
   proto::BodySpec body_spec_;
   ParticleSet<D> particles_;
   std::vector<BoundaryFace<D>> faces_;  // the placement's exact faces, if it knows them
+  std::vector<CellMoments<D>> cells_;   // the particles' cells, if the placement knows them
   Kernel kernel_;
   Domain<D> domain_;
   double time_ = 0.0;

@@ -57,11 +57,6 @@ double dual_cell_depth(const Shape<D>& shape, const Vec<D>& x, const Vec<D>& dir
 // measured on the 4^D sub-points that measure its volume, each standing for its sub-cell (whose
 // own covariance is added): exact wherever lattice_fill's volume is.
 template <int D>
-struct CellMoments {
-  Vec<D> centroid;
-  Mat<D> covariance;
-};
-template <int D>
 CellMoments<D> cell_moments(const Shape<D>& shape, const Vec<D>& x, double spacing,
                             LatticePlacement placement);
 

@@ -21,11 +21,20 @@ struct BoundaryFace {
   std::vector<Vec<D>> areas;           // outward N dA of particles[k], reference configuration
 };
 
+// The centroid (relative to the particle) and covariance of the region a particle stands for: what
+// an integration over the particles' cells needs (solid energy_quadrature: dual_cell).
+template <int D>
+struct CellMoments {
+  Vec<D> centroid;
+  Mat<D> covariance;
+};
+
 template <int D>
 struct ParticleCloud {
   std::vector<Vec<D>> positions;
   std::vector<double> volumes;         // one per position, > 0
   std::vector<BoundaryFace<D>> faces;  // empty unless the placement knows the faces
+  std::vector<CellMoments<D>> cells;   // one per position where the placement knows its cells
 };
 
 }  // namespace cosph

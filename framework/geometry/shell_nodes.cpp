@@ -101,6 +101,31 @@ int ring_count(double rho, double spacing) {
   return std::max(3, static_cast<int>(std::lround(2.0 * std::numbers::pi * rho / spacing)));
 }
 
+// The integrals over a node's meridian dual region (per unit v) of J, J rho, J z, J rho^2,
+// J rho z and J z^2, with J the volume per dt ds dv.
+struct MeridianMoments {
+  double m0, rho, z, rho2, rhoz, z2;
+};
+
+// The centroid (relative to the node x) and covariance of the dual cell that spans
+// v in [v - a, v + a], a = pi / count, over a meridian region of moments m.
+CellMoments<3> ring_cell(const MeridianMoments& m, const Vec<3>& x, double v, int count) {
+  const double a = std::numbers::pi / count;
+  const double c = std::cos(v), s = std::sin(v), s1 = 2.0 * std::sin(a);
+  const double half_sin2 = 0.5 * std::sin(2.0 * a);
+  const double volume = 2.0 * a * m.m0;
+  const Vec<3> first(m.rho * s1 * c, m.rho * s1 * s, 2.0 * a * m.z);
+  Mat<3> second;
+  second(0, 0) = m.rho2 * (a + half_sin2 * std::cos(2.0 * v));
+  second(1, 1) = m.rho2 * (a - half_sin2 * std::cos(2.0 * v));
+  second(0, 1) = second(1, 0) = m.rho2 * half_sin2 * std::sin(2.0 * v);
+  second(0, 2) = second(2, 0) = m.rhoz * s1 * c;
+  second(1, 2) = second(2, 1) = m.rhoz * s1 * s;
+  second(2, 2) = 2.0 * a * m.z2;
+  const Vec<3> mean = first / volume;
+  return {mean - x, second / volume - mean * mean.transpose()};
+}
+
 // The outward area vector of a ring node's share of a face whose meridian profile has in-plane
 // area density (n_rho, n_z) per unit of v (already integrated over the node's dual interval):
 // integrating the rotated normal over v in [v - a, v + a], a = pi / count.
@@ -156,9 +181,21 @@ ParticleCloud<3> conforming_shell_nodes(const TruncatedEllipsoidalShell& shell, 
       const MeridianPoint p = map.at(t, s);
       const bool apex = j == ns;
       const int count = apex ? 1 : ring_count(p.rho, spacing);
-      const double band = gauss(t0, t1, [&](double tt) {
-        return gauss(s0, s1, [&](double ss) { return jacobian(tt, ss); });
-      });
+      const auto integral = [&](auto&& weight) {
+        return gauss(t0, t1, [&](double tt) {
+          return gauss(s0, s1, [&](double ss) {
+            const MeridianPoint q = map.at(tt, ss);
+            return jacobian(tt, ss) * weight(q);
+          });
+        });
+      };
+      const double band = integral([](const MeridianPoint&) { return 1.0; });
+      const MeridianMoments moments{band,
+                                    integral([](const MeridianPoint& q) { return q.rho; }),
+                                    integral([](const MeridianPoint& q) { return q.z; }),
+                                    integral([](const MeridianPoint& q) { return q.rho * q.rho; }),
+                                    integral([](const MeridianPoint& q) { return q.rho * q.z; }),
+                                    integral([](const MeridianPoint& q) { return q.z * q.z; })};
       // Face densities per unit v over the node's dual interval: rho times the meridian
       // tangent turned outwards (away from the body's interior, i.e. against x_t on t = 0, along
       // it on t = 1, against x_s on s = 0).
@@ -190,6 +227,7 @@ ParticleCloud<3> conforming_shell_nodes(const TruncatedEllipsoidalShell& shell, 
         const double rho = apex ? 0.0 : p.rho;
         cloud.positions.emplace_back(rho * std::cos(v), rho * std::sin(v), p.z);
         cloud.volumes.push_back(band * 2.0 * std::numbers::pi / count);
+        cloud.cells.push_back(ring_cell(moments, cloud.positions.back(), v, count));
         const auto add = [&](BoundaryFace<3>& face, const std::array<double, 2>& n) {
           face.particles.push_back(index);
           face.areas.push_back(ring_area(n[0], n[1], v, count));

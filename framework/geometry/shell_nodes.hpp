@@ -19,7 +19,8 @@
 // neighbouring rings in s, clipped at the faces, and its share of the ring in v), integrated
 // exactly enough (Gauss-Legendre) that
 // the volumes sum to the shell's volume to round-off. The faces "inner", "outer" and "base" come
-// with each node's outward area vector over the same dual cell.
+// with each node's outward area vector over the same dual cell, and each node its dual cell's
+// centroid and covariance (ParticleCloud::cells), integrated the same way.
 #pragma once
 
 #include "geometry/particle_cloud.hpp"

@@ -479,11 +479,11 @@ class SolidModule final : public StaticBodyModule<D> {
                         "dual_cell needs gradient_correction: quadratic (F at the cell's "
                         "points comes from the quadratic fit)");
     const auto& body = spec_.body();
-    if (!body.has_shape() || lattice_placement(body) == LatticePlacement::conforming ||
-        body.perturbation() != 0.0)
+    if (!body.has_shape() || body.perturbation() != 0.0)
       throw ConfigError(key,
-                        "dual_cell needs a body filled on an unperturbed lattice (placement "
-                        "cell or vertex): the lattice defines the particles' cells");
+                        "dual_cell needs a body placed on an unperturbed lattice or the "
+                        "conforming grid (placement cell, vertex or conforming): they "
+                        "define the particles' cells");
   }
 
   // W per unit reference volume: at the particle, or the mean over its cell's points.
@@ -498,12 +498,16 @@ class SolidModule final : public StaticBodyModule<D> {
 
   // The energy's points in every particle's cell (scene key energy_quadrature).
   void build_energy_quadrature() {
-    if (!body_shape_) body_shape_ = build_shape<D>(spec_.body().shape(), key_ + ".body.shape");
     const LatticePlacement placement = lattice_placement(spec_.body());
     const double spacing = spec_.body().spacing();
+    // A conforming placement gives its cells; a lattice's are measured on the shape.
+    if (placement != LatticePlacement::conforming && !body_shape_)
+      body_shape_ = build_shape<D>(spec_.body().shape(), key_ + ".body.shape");
     quadrature_.offset.resize(X_.size());
     parallel_for_each_index(X_.size(), [&](std::size_t i) {
-      const CellMoments<D> cell = cell_moments<D>(*body_shape_, X_[i], spacing, placement);
+      const CellMoments<D> cell = Base::cells_.empty()
+                                      ? cell_moments<D>(*body_shape_, X_[i], spacing, placement)
+                                      : Base::cells_[i];
       quadrature_.offset[i] = EnergyQuadrature<D>::points_of(cell.centroid, cell.covariance);
     });
     Fq_.assign(X_.size(), {});
@@ -1085,7 +1089,7 @@ class SolidModule final : public StaticBodyModule<D> {
   Vec<D> body_force_ = Vec<D>::Zero();
   std::vector<Vec<D>> external_force_;
   mutable std::optional<Surface<D>> surface_;
-  ShapePtr<D> body_shape_;                           // built for vertex pressure areas only
+  ShapePtr<D> body_shape_;  // built for vertex pressure areas and lattice cells only
   std::vector<Vec<D>> u0_, v0_, us_, vs_, du_, dv_;  // RK4 stages (RK4 only)
   static constexpr long long kStiffnessInterval = 1000;
   // Steady state only.

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -40,6 +41,57 @@ Vec<3> face_sum(const BoundaryFace<3>& f) {
   Vec<3> sum = Vec<3>::Zero();
   for (const auto& a : f.areas) sum += a;
   return sum;
+}
+
+// Integrals over the spheroid (a, a, c) below the plane z = h of z, z^2 and x^2: the
+// antiderivatives of pi a^2 (1 - z^2 / c^2) z^k and of pi a^4 (1 - z^2 / c^2)^2 / 4 (a disc's x^2)
+// from -c to h.
+double cap_z(double a, double c, double h) {
+  const auto f = [&](double z) { return z * z / 2.0 - z * z * z * z / (4.0 * c * c); };
+  return std::numbers::pi * a * a * (f(h) - f(-c));
+}
+double cap_zz(double a, double c, double h) {
+  const auto f = [&](double z) { return z * z * z / 3.0 - std::pow(z, 5) / (5.0 * c * c); };
+  return std::numbers::pi * a * a * (f(h) - f(-c));
+}
+double cap_xx(double a, double c, double h) {
+  const auto f = [&](double z) {
+    return z - 2.0 * z * z * z / (3.0 * c * c) + std::pow(z, 5) / (5.0 * std::pow(c, 4));
+  };
+  return std::numbers::pi * std::pow(a, 4) / 4.0 * (f(h) - f(-c));
+}
+
+// Each node's dual cell comes with its centroid and covariance (for the solid's dual-cell energy):
+// summed with the volumes they give the shell's own first and second moments.
+TEST(ConformingShell, CellMomentsSumToTheShellsMoments) {
+  const double z = cap_z(10.0, 20.0, 5.0) - cap_z(7.0, 17.0, 5.0);
+  const double zz = cap_zz(10.0, 20.0, 5.0) - cap_zz(7.0, 17.0, 5.0);
+  const double xx = cap_xx(10.0, 20.0, 5.0) - cap_xx(7.0, 17.0, 5.0);
+  for (double spacing : {1.0, 0.6}) {
+    const auto cloud = conforming_shell_nodes(kLand, spacing);
+    ASSERT_EQ(cloud.cells.size(), cloud.positions.size());
+    Vec<3> first = Vec<3>::Zero();
+    Mat<3> second = Mat<3>::Zero();
+    double widest = 0.0;
+    for (std::size_t i = 0; i < cloud.positions.size(); ++i) {
+      const auto& cell = cloud.cells[i];
+      const Vec<3> mean = cloud.positions[i] + cell.centroid;
+      first += cloud.volumes[i] * mean;
+      second += cloud.volumes[i] * (cell.covariance + mean * mean.transpose());
+      EXPECT_GT(cell.covariance.eigenvalues().real().minCoeff(), 0.0) << "node " << i;
+      widest = std::max(widest, cell.centroid.norm() / spacing);
+    }
+    std::cout << "spacing " << spacing << ": first moment z " << first[2] << " (exact " << z
+              << "), zz " << second(2, 2) << " (" << zz << "), xx " << second(0, 0) << " (" << xx
+              << "), largest |centroid| " << widest << " spacings\n";
+    EXPECT_NEAR(first[2] / z, 1.0, 1e-10);
+    EXPECT_NEAR(second(2, 2) / zz, 1.0, 1e-10);
+    EXPECT_NEAR(second(0, 0) / xx, 1.0, 1e-10);
+    EXPECT_NEAR(second(1, 1) / xx, 1.0, 1e-10);
+    EXPECT_LT(std::abs(first[0]) + std::abs(first[1]), 1e-10 * std::abs(z));
+    EXPECT_LT(std::abs(second(0, 1)) + std::abs(second(0, 2)), 1e-10 * xx);
+    EXPECT_LT(widest, 0.5);  // within the node's own cell
+  }
 }
 
 TEST(ConformingShell, VolumesSumToTheShellsVolume) {
