@@ -196,19 +196,10 @@ void check_force_is_energy_gradient(GradientCorrection correction) {
   std::vector<Mat<D>> F(count), P(count);
   deformation_gradients<D>(b.pairs, u, F);
   for (std::size_t i = 0; i < count; ++i) P[i] = m.stress(F[i], Mat<D>::Identity());
-  double worst = 0.0, scale = 0.0;
-  const double eps = 1e-7 * kDp;
-  for (std::size_t i = 0; i < count; ++i) {
-    const Vec<D> force = b.V[i] * pair_stress_divergence<D>(b.pairs, P, i);
-    for (int a = 0; a < D; ++a) {
-      auto plus = u, minus = u;
-      plus[i][a] += eps;
-      minus[i][a] -= eps;
-      const double fd = -(energy(plus) - energy(minus)) / (2.0 * eps);
-      worst = std::max(worst, std::abs(force[a] - fd));
-      scale = std::max(scale, std::abs(fd));
-    }
-  }
+  const auto [worst, scale] = test::energy_gradient_mismatch<D>(
+      u, energy,
+      [&](std::size_t i) { return Vec<D>(b.V[i] * pair_stress_divergence<D>(b.pairs, P, i)); },
+      1e-7 * kDp);
   std::cout << D << "D " << (correction == GradientCorrection::quadratic ? "quadratic" : "linear")
             << ": max |V f + dE/dx| / max |dE/dx| " << worst / scale << "\n";
   EXPECT_GT(scale, 0.0);

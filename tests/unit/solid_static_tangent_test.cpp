@@ -110,16 +110,7 @@ Problem<D> make_problem(GradientCorrection correction, unsigned seed, bool contr
   if (quadrature) {  // the curvature, and cells of random centroids and covariances
     p.body.pairs = build_reference_pairs<D>(p.body.X, p.body.V, p.body.kernel, correction, false,
                                             {.wanted = true});
-    std::uniform_real_distribution<double> unit(-1.0, 1.0);
-    for (std::size_t i = 0; i < p.body.X.size(); ++i) {
-      Vec<D> c;
-      Mat<D> M;
-      for (int a = 0; a < D; ++a) {
-        c[a] = 0.2 * kTestSpacing * unit(rng);
-        for (int b = 0; b < D; ++b) M(a, b) = 0.3 * kTestSpacing * unit(rng);
-      }
-      p.quadrature.offset.push_back(EnergyQuadrature<D>::points_of(c, M * M.transpose()));
-    }
+    p.quadrature = test::random_cells<D>(p.body.X.size(), rng);
   }
   const std::size_t count = p.body.X.size();
   p.dof.assign(count * D, 0);
