@@ -69,32 +69,31 @@ TangentPattern build_tangent_pattern(const ReferencePairs<D>& pairs) {
   return pattern;
 }
 
+namespace {
+
 template <int D>
-Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
-                                             const TangentPattern& pattern,
-                                             const std::vector<double>& volume,
-                                             const std::vector<MaterialTangent<D>>& C,
-                                             const std::vector<Index>& force_tangent_particles,
-                                             const std::vector<ForceTangent<D>>& force_tangents,
-                                             const std::vector<long long>& dof, long long unknowns,
-                                             const FitResidualControl<D>* control,
-                                             const EnergyQuadrature<D>* quadrature) {
-  using Block = Mat<D>;
-  using Contracted = Eigen::Matrix<double, D * D, D>;
+using Block = Mat<D>;
+template <int D>
+using Contracted = Eigen::Matrix<double, D * D, D>;
+
+// Adds the material stiffness sum_i V_i sum_q w_q H^q_ij^T C_iq H^q_ik to the pattern's blocks K,
+// one point q at a time (one point, at the particle, without a quadrature), and the zero-energy
+// control's constant stiffness.
+template <int D>
+void add_material_stiffness(const ReferencePairs<D>& pairs, const TangentPattern& pattern,
+                            const std::vector<double>& volume,
+                            const std::vector<MaterialTangent<D>>& C,
+                            const FitResidualControl<D>* control,
+                            const EnergyQuadrature<D>* quadrature, std::vector<Block<D>>& K) {
   const NeighbourList& nl = pairs.neighbours;
   const std::size_t n = nl.particle_count();
   std::vector<std::size_t> slot_offset(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) slot_offset[i + 1] = slot_offset[i] + slots(nl, i);
-  std::vector<long long> own_force(n, -1);
-  for (std::size_t m = 0; m < force_tangent_particles.size(); ++m)
-    own_force[force_tangent_particles[m]] = static_cast<long long>(m);
-  std::vector<Block> K(pattern.column.size(), Block::Zero());
-  std::vector<Contracted> Q(slot_offset[n]);
+  std::vector<Contracted<D>> Q(slot_offset[n]);
   const int points = quadrature ? EnergyQuadrature<D>::points : 1;
   const double weight = 1.0 / points;
   for (int q = 0; q < points; ++q) {
-    // The coefficients of F at point q of particle i's dual cell (at the particle itself without
-    // a quadrature): c_ik + h_ik d_q.
+    // The coefficients of F at point q of particle i's dual cell: c_ik + h_ik d_q.
     auto coefficient_at = [&](std::size_t i, std::size_t slot) -> Vec<D> {
       if (!quadrature) return coefficient(pairs, i, slot);
       return coefficient(pairs, i, slot) +
@@ -105,7 +104,7 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
       const MaterialTangent<D>& Ci = C[i * points + q];
       for (std::size_t s = 0; s < slots(nl, i); ++s) {
         const Vec<D> c = coefficient_at(i, s);
-        Contracted& out = Q[slot_offset[i] + s];
+        Contracted<D>& out = Q[slot_offset[i] + s];
         for (int col = 0; col < D; ++col) {
           Eigen::Matrix<double, D * D, 1> sum = Eigen::Matrix<double, D * D, 1>::Zero();
           for (int d = 0; d < D; ++d) sum += Ci.col(col * D + d) * c[d];
@@ -118,8 +117,8 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
       auto add_particle = [&](std::size_t i, std::size_t slot_of_j) {
         const Vec<D> c_ij = coefficient_at(i, slot_of_j);
         for (std::size_t s = 0; s < slots(nl, i); ++s) {
-          const Contracted& Qs = Q[slot_offset[i] + s];
-          Block b = Block::Zero();
+          const Contracted<D>& Qs = Q[slot_offset[i] + s];
+          Block<D> b = Block<D>::Zero();
           for (int a = 0; a < D; ++a)
             for (int bb = 0; bb < D; ++bb) b.row(a) += c_ij[bb] * Qs.row(a * D + bb);
           b *= weight * volume[i];
@@ -131,22 +130,39 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
       // Neighbour i's slot of j: the reverse pair's place in i's list (slot 0 is i itself).
       for (std::size_t k = nl.offset[j]; k < nl.offset[j + 1]; ++k)
         add_particle(nl.index[k], pairs.reverse_pair[k] - nl.offset[nl.index[k]] + 1);
-      if (q == 0 && own_force[j] >= 0) {
-        const ForceTangent<D>& L = force_tangents[static_cast<std::size_t>(own_force[j])];
-        for (std::size_t s = 0; s < slots(nl, j); ++s) {
-          const Vec<D> c = coefficient(pairs, j, s);
-          Block b = Block::Zero();
-          for (int col = 0; col < D; ++col)
-            for (int d = 0; d < D; ++d) b.col(col) += L.col(col * D + d) * c[d];
-          K[find_column(pattern, j, node(pairs, j, s))] -= b;
-        }
-      }
     });
   }
+}
 
-  // The lower triangle of the symmetric part on the free unknowns, in compressed column storage
-  // (what the Cholesky factorisation reads). Column dof(j, a) holds rows dof(k, c) >= dof(j, a)
-  // of the blocks (j, k), k ascending: K_s(k, j)[c][a] = K_s(j, k)[a][c].
+// Subtracts L_i H_ik from row i for the particles with a force of their own (L_i = df_i/dF_i).
+template <int D>
+void add_own_force_stiffness(const ReferencePairs<D>& pairs, const TangentPattern& pattern,
+                             const std::vector<Index>& force_tangent_particles,
+                             const std::vector<ForceTangent<D>>& force_tangents,
+                             std::vector<Block<D>>& K) {
+  const NeighbourList& nl = pairs.neighbours;
+  parallel_for_each_index(force_tangent_particles.size(), [&](std::size_t m) {
+    const std::size_t j = force_tangent_particles[m];
+    const ForceTangent<D>& L = force_tangents[m];
+    for (std::size_t s = 0; s < slots(nl, j); ++s) {
+      const Vec<D> c = coefficient(pairs, j, s);
+      Block<D> b = Block<D>::Zero();
+      for (int col = 0; col < D; ++col)
+        for (int d = 0; d < D; ++d) b.col(col) += L.col(col * D + d) * c[d];
+      K[find_column(pattern, j, node(pairs, j, s))] -= b;
+    }
+  });
+}
+
+// The lower triangle of the symmetric part of the blocks K on the free unknowns, in compressed
+// column storage (what the Cholesky factorisation reads). Column dof(j, a) holds rows
+// dof(k, c) >= dof(j, a) of the blocks (j, k), k ascending: K_s(k, j)[c][a] = K_s(j, k)[a][c].
+template <int D>
+Eigen::SparseMatrix<double> lower_symmetric_part(const TangentPattern& pattern,
+                                                 const std::vector<Block<D>>& K,
+                                                 const std::vector<long long>& dof,
+                                                 long long unknowns) {
+  const std::size_t n = pattern.offset.size() - 1;
   auto for_each_lower_entry = [&](std::size_t j, int a, auto&& visit) {
     const long long col = dof[j * D + a];
     for (std::size_t p = pattern.offset[j]; p < pattern.offset[j + 1]; ++p) {
@@ -181,7 +197,7 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
       if (col < 0) continue;
       long long at = column_start[static_cast<std::size_t>(col)];
       for_each_lower_entry(j, a, [&](std::size_t p, Index k, int c, long long row) {
-        const Block& backward = K[find_column(pattern, k, static_cast<Index>(j))];
+        const Block<D>& backward = K[find_column(pattern, k, static_cast<Index>(j))];
         inner[at] = static_cast<int>(row);
         value[at] = 0.5 * (K[p](a, c) + backward(c, a));
         ++at;
@@ -189,6 +205,24 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
     }
   });
   return matrix;
+}
+
+}  // namespace
+
+template <int D>
+Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
+                                             const TangentPattern& pattern,
+                                             const std::vector<double>& volume,
+                                             const std::vector<MaterialTangent<D>>& C,
+                                             const std::vector<Index>& force_tangent_particles,
+                                             const std::vector<ForceTangent<D>>& force_tangents,
+                                             const std::vector<long long>& dof, long long unknowns,
+                                             const FitResidualControl<D>* control,
+                                             const EnergyQuadrature<D>* quadrature) {
+  std::vector<Block<D>> K(pattern.column.size(), Block<D>::Zero());
+  add_material_stiffness<D>(pairs, pattern, volume, C, control, quadrature, K);
+  add_own_force_stiffness<D>(pairs, pattern, force_tangent_particles, force_tangents, K);
+  return lower_symmetric_part<D>(pattern, K, dof, unknowns);
 }
 
 #define COSPH_INSTANTIATE_STATIC_TANGENT(D)                                          \
