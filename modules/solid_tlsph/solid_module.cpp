@@ -229,7 +229,7 @@ class SolidModule final : public StaticBodyModule<D> {
         if (stress) particles_.matrix("stress")[i] = sigma;
         if (vm) particles_.scalar("von_mises")[i] = von_mises(sigma, out_of_plane_stress(i));
       }
-      if (energy) particles_.scalar("strain_energy")[i] = strain_energy(i, frame);
+      if (energy) particles_.scalar("strain_energy")[i] = strain_energy(i, frame, u);
       if (fibre) {
         const Mat<D> E = 0.5 * (F_[i].transpose() * F_[i] - Mat<D>::Identity());
         const Mat<D> local = frame.transpose() * E * frame;
@@ -486,11 +486,17 @@ class SolidModule final : public StaticBodyModule<D> {
                         "define the particles' cells");
   }
 
-  // W per unit reference volume: at the particle, or the mean over its cell's points.
-  double strain_energy(std::size_t i, const Mat<D>& frame) const {
+  // W per unit reference volume at displacements u (F_ holds their F): at the particle, or the
+  // mean over its cell's points.
+  double strain_energy(std::size_t i, const Mat<D>& frame, const std::vector<Vec<D>>& u) const {
     if (quadrature_.offset.empty()) return material_.energy(F_[i], frame);
+    const GradientSlopes<D> S = deformation_gradient_slopes<D>(pairs_, u, i);
     double sum = 0.0;
-    for (const Mat<D>& F_q : Fq_[i]) sum += material_.energy(F_q, frame);
+    for (const Vec<D>& d : quadrature_.offset[i]) {
+      Mat<D> F_q = F_[i];
+      for (int c = 0; c < D; ++c) F_q.noalias() += d[c] * S[c];
+      sum += material_.energy(F_q, frame);
+    }
     return sum / EnergyQuadrature<D>::points;
   }
 
