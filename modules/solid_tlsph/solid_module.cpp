@@ -136,7 +136,7 @@ class SolidModule final : public StaticBodyModule<D> {
                                         spec_.gradient_correction() == "quadratic"
                                             ? GradientCorrection::quadratic
                                             : GradientCorrection::linear,
-                                        pair_hourglass(), {.wanted = dual_cell_quadrature()});
+                                        pair_hourglass(), dual_cell_quadrature());
     } catch (const RuntimeError& e) {
       throw RuntimeError("module '" + name_ + "': " + e.what());
     }

@@ -19,8 +19,8 @@ namespace {
 // reliably or the fit would stiffen the operator too much: then the linear correction stays.
 template <int D>
 bool quadratic_gradients(const std::vector<Vec<D>>& X, const NeighbourList& nl,
-                         const std::vector<double>& omega, double h, double max_amplification,
-                         std::size_t i, std::vector<Vec<D>>& g, std::vector<Mat<D>>* curvature) {
+                         const std::vector<double>& omega, double h, std::size_t i,
+                         std::vector<Vec<D>>& g, std::vector<Mat<D>>* curvature) {
   constexpr int m = D + D * (D + 1) / 2;
   using Basis = Eigen::Matrix<double, m, 1>;
   auto basis = [&](const Vec<D>& X_ij) {
@@ -52,6 +52,7 @@ bool quadratic_gradients(const std::vector<Vec<D>>& X, const NeighbourList& nl,
   // positions jittered by 0.15 dp) and a face particle's 3.7 in 3D; edges (3D) 6.2-6.4, corners
   // 6.9 (2D) and 8.4 (3D). Edges and corners keep the linear correction: the rubber gate's stable
   // step grows by a fifth, its swing and the oscillating plate's period stay (docs/ARCHITECTURE).
+  constexpr double kMaxAmplification = 6.0;
   const std::size_t begin = nl.offset[i], count = nl.offset[i + 1] - begin;
   std::vector<Vec<D>> fitted(count);
   std::vector<Mat<D>> second(curvature ? count : 0);
@@ -71,7 +72,7 @@ bool quadratic_gradients(const std::vector<Vec<D>>& X, const NeighbourList& nl,
         second[k](a, b) = second[k](b, a) = value;
       }
   }
-  if (!(quadratic <= max_amplification * linear)) return false;
+  if (!(quadratic <= kMaxAmplification * linear)) return false;
   std::copy(fitted.begin(), fitted.end(), g.begin() + static_cast<std::ptrdiff_t>(begin));
   if (curvature)
     std::copy(second.begin(), second.end(),
@@ -120,7 +121,7 @@ template <int D>
 ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
                                         const std::vector<double>& volume, const Kernel& kernel,
                                         GradientCorrection correction, bool hourglass,
-                                        const CurvatureOptions& curvature) {
+                                        bool curvature) {
   ReferencePairs<D> pairs;
   const Domain<D> free_space;  // a solid body is never periodic
   pairs.neighbours = build_inner_list<D>(X, kernel.support_radius(), free_space);
@@ -133,7 +134,7 @@ ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
   std::vector<double> omega(nl.pair_count());
   if (hourglass) pairs.hourglass_weight.resize(nl.pair_count());
   std::vector<char> quadratic(X.size(), 0);
-  if (curvature.wanted) {
+  if (curvature) {
     pairs.curvature.assign(nl.pair_count(), Mat<D>::Zero());
     pairs.curvature_sum.assign(X.size(), Mat<D>::Zero());
   }
@@ -148,13 +149,12 @@ ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
         pairs.hourglass_weight[k] = volume[j] * kernel.value(distance) / (distance * distance);
     }
     if (correction == GradientCorrection::quadratic)
-      quadratic[i] =
-          quadratic_gradients<D>(X, nl, omega, h, curvature.max_amplification, i, pairs.gradient,
-                                 curvature.wanted ? &pairs.curvature : nullptr);
+      quadratic[i] = quadratic_gradients<D>(X, nl, omega, h, i, pairs.gradient,
+                                            curvature ? &pairs.curvature : nullptr);
     Vec<D> sum = Vec<D>::Zero();
     for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) sum += pairs.gradient[k];
     pairs.gradient_sum[i] = sum;
-    if (curvature.wanted) {
+    if (curvature) {
       Mat<D> second = Mat<D>::Zero();
       for (std::size_t k = nl.offset[i]; k < nl.offset[i + 1]; ++k) second += pairs.curvature[k];
       pairs.curvature_sum[i] = second;
@@ -217,9 +217,9 @@ Vec<D> hourglass_force(const ReferencePairs<D>& pairs, const std::vector<Vec<D>>
 }
 
 #define COSPH_INSTANTIATE_TLSPH(D)                                                                \
-  template ReferencePairs<D> build_reference_pairs<D>(                                            \
-      const std::vector<Vec<D>>&, const std::vector<double>&, const Kernel&, GradientCorrection,  \
-      bool, const CurvatureOptions&);                                                             \
+  template ReferencePairs<D> build_reference_pairs<D>(const std::vector<Vec<D>>&,                 \
+                                                      const std::vector<double>&, const Kernel&,  \
+                                                      GradientCorrection, bool, bool);            \
   template void deformation_gradients<D>(const ReferencePairs<D>&, const std::vector<Vec<D>>&,    \
                                          std::vector<Mat<D>>&);                                   \
   template Vec<D> artificial_viscosity<D>(const ReferencePairs<D>&, const std::vector<Vec<D>>&,   \

@@ -54,22 +54,12 @@ struct ReferencePairs {
   }
   // Only with hourglass control: V_j W_ij / |X_ij|^2 per pair.
   std::vector<double> hourglass_weight;
-  // Only where asked (CurvatureOptions): the quadratic fit's second-derivative coefficients h_ij,
-  // symmetric, so that the fitted d2u/dX_b dX_c at particle i is sum_j (u_j - u_i) h_ij(b, c)
-  // (zero where the linear correction holds), and their sums over j.
+  // Only where asked (build_reference_pairs' `curvature`): the quadratic fit's second-derivative
+  // coefficients h_ij, symmetric, so that the fitted d2u/dX_b dX_c at particle i is sum_j (u_j -
+  // u_i) h_ij(b, c) (zero where the linear correction holds), and their sums over j.
   std::vector<Mat<D>> curvature;
   std::vector<Mat<D>> curvature_sum;
   std::vector<Mat<D>> curvature_reverse;  // -(V_j / V_i) h_ji, as `reverse` is for g
-};
-
-// The quadratic fit keeps its gradient coefficients where they amplify sum_j |g_ij|^2 at most
-// this many times over the linear correction's: the explicit step goes as 1 / |g| (edges and
-// corners of a lattice body exceed it; see quadratic_gradients).
-inline constexpr double kExplicitMaxAmplification = 6.0;
-
-struct CurvatureOptions {
-  bool wanted = false;  // keep the fit's second-derivative coefficients
-  double max_amplification = kExplicitMaxAmplification;
 };
 
 // Where a particle's strain energy is sampled when it is integrated over the particle's dual cell
@@ -103,7 +93,7 @@ template <int D>
 ReferencePairs<D> build_reference_pairs(const std::vector<Vec<D>>& X,
                                         const std::vector<double>& volume, const Kernel& kernel,
                                         GradientCorrection correction, bool hourglass,
-                                        const CurvatureOptions& curvature = {});
+                                        bool curvature = false);
 
 // F_i = I + sum_j (u_j - u_i) g_ij^T from the displacements, for one particle (inline: the
 // solid fuses it with the stress in one loop) and for all.

@@ -26,9 +26,8 @@ namespace {
 constexpr double kDp = test::kTestSpacing;
 
 template <int D>
-ReferencePairs<D> pairs_with_curvature(const test::TlsphBody<D>& b, double max_amplification) {
-  return build_reference_pairs<D>(b.X, b.V, b.kernel, GradientCorrection::quadratic, false,
-                                  {.wanted = true, .max_amplification = max_amplification});
+ReferencePairs<D> pairs_with_curvature(const test::TlsphBody<D>& b) {
+  return build_reference_pairs<D>(b.X, b.V, b.kernel, GradientCorrection::quadratic, false, true);
 }
 
 // u_a = sum_b A_ab X_b + X^T H_a X: F = I + A + 2 H_a X per row, dF_ab / dX_c = 2 H_a(b, c).
@@ -39,7 +38,7 @@ void check_curvature_exact(double jitter) {
   n[0] = 7;
   test::TlsphBody<D> b = test::make_tlsph_body<D>(test::lattice_box<D>(n, jitter, 3), {},
                                                   GradientCorrection::quadratic, false);
-  b.pairs = pairs_with_curvature<D>(b, kExplicitMaxAmplification);
+  b.pairs = pairs_with_curvature<D>(b);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> r(-0.1, 0.1);
   Mat<D> A;
@@ -132,7 +131,7 @@ void check_force_is_energy_gradient() {
   const auto X = test::lattice_box<D>(n, 0.15, 9);
   for (std::size_t i = 0; i < X.size(); ++i) V.push_back(std::pow(kDp, D) * (1.0 + 0.2 * r(rng)));
   test::TlsphBody<D> b = test::make_tlsph_body<D>(X, V, GradientCorrection::quadratic, false);
-  b.pairs = pairs_with_curvature<D>(b, kExplicitMaxAmplification);
+  b.pairs = pairs_with_curvature<D>(b);
   const EnergyQuadrature<D> quadrature = test::random_cells<D>(X.size(), rng);
   const MaterialModel<D> material(neo_hookean(), "material");
   const Mat<D> frame = Mat<D>::Identity();
@@ -210,7 +209,7 @@ double vertex_bending_energy_ratio(bool dual_cell) {
       lattice_fill<2>(plate, kDp, Vec<2>(0, -0.5 * t), LatticePlacement::vertex);
   test::TlsphBody<2> b = test::make_tlsph_body<2>(cloud.positions, cloud.volumes,
                                                   GradientCorrection::quadratic, false);
-  b.pairs = pairs_with_curvature<2>(b, kExplicitMaxAmplification);
+  b.pairs = pairs_with_curvature<2>(b);
   EnergyQuadrature<2> quadrature;
   for (const auto& x : b.X) {
     const auto cell = cell_moments<2>(plate, x, kDp, LatticePlacement::vertex);

@@ -108,8 +108,8 @@ Problem<D> make_problem(GradientCorrection correction, unsigned seed, bool contr
   // kappa mu at half of E: the control's stiffness comparable to the material's.
   if (control) p.control.emplace(p.body.X, p.body.V, p.body.pairs, p.body.kernel, 5e5);
   if (quadrature) {  // the curvature, and cells of random centroids and covariances
-    p.body.pairs = build_reference_pairs<D>(p.body.X, p.body.V, p.body.kernel, correction, false,
-                                            {.wanted = true});
+    p.body.pairs =
+        build_reference_pairs<D>(p.body.X, p.body.V, p.body.kernel, correction, false, true);
     p.quadrature = test::random_cells<D>(p.body.X.size(), rng);
   }
   const std::size_t count = p.body.X.size();
