@@ -23,8 +23,11 @@ namespace cosph {
 // (its length in 2D): the pressure on each column of wall particles (the force summed over the
 // column's layers per unit of its share), averaged over the face. It is exact for a uniform
 // pressure whatever the face's size, and a sensor narrower than a particle reads the column in
-// front of it. The face must lie on the wall (a face over a wall's edge reads low), and a sensor
-// that no wall particle covers reads NaN.
+// front of it. In a concave corner, where another wall's first layer lies in front of the plane,
+// the particles behind that layer are not behind the face: the water pushes them along the pairs'
+// diagonals, and each passes its force to the nearest particle behind the face (within `depth`),
+// so that a face at the wall's foot reads the push on its end. The face must lie on the wall (a
+// face over a wall's edge reads low), and a sensor that no wall particle covers reads NaN.
 template <int D>
 class WallSensor {
  public:
