@@ -80,34 +80,34 @@ double WallSensor<D>::covered(const Vec<D>& offset, double a) const {
 }
 
 template <int D>
-template <typename F>
-void WallSensor<D>::for_each_covered(const ParticleSet<D>& wall, double depth,
-                                     const Domain<D>& domain, std::size_t s, const F& f) const {
+void WallSensor<D>::near_face(const ParticleSet<D>& wall, double depth, const Domain<D>& domain,
+                              std::size_t s, std::vector<Near>& behind,
+                              std::vector<Near>& front) const {
   const auto& x = wall.vector("position");
   const auto& volume = wall.scalar("volume");
-  // The particles behind the face's plane within the depth, and those in front of it within their
-  // own side a (the first layer of a wall that meets this one), both within reach of the face
-  // along the plane (farther ones can neither be covered nor pass their force to a covered one).
-  struct Near {
-    std::size_t w;
-    Vec<D> r;  // x_w - centre, minimum image
-    double a;
-  };
-  std::vector<Near> behind, front;
+  behind.clear();
+  front.clear();
   for (std::size_t w = 0; w < x.size(); ++w) {
     const Vec<D> r = domain.displacement(x[w], centres_[s]);
     const double a = std::pow(volume[w], 1.0 / D);
     const double along = -r.dot(normal_);  // > 0: behind the plane
+    // Farther along the plane a particle can neither be covered nor pass its force to one that is.
     if ((r + along * normal_).norm() > radius_ + depth + a) continue;
     if (along > 0.0 && along <= depth) behind.push_back({w, r, a});
     if (along <= 0.0 && along > -a) front.push_back({w, r, a});
   }
-  // A particle behind the plane whose share of the plane lies under a particle in front of it is
-  // not behind the face: it is behind another wall's first layer, in the concave corner where
-  // the two walls meet. The water's push on the corner goes to such particles along the pairs'
-  // diagonals; its component along this face's normal acts on the face's end, so each passes it
-  // to the nearest particle that is behind the face (within the depth: the kernel's support).
-  // Without this, a sensor at the foot of a wall of water at rest read 22% low.
+}
+
+// A particle behind the plane whose share of the plane lies under a particle in front of it is
+// not behind the face: it is behind another wall's first layer, in the concave corner where the
+// two walls meet. The water pushes the corner along the pairs' diagonals; the component along
+// this face's normal acts on the face's end, so each such particle passes its force to the nearest
+// particle behind the face (ties: the first in the wall's order; none beyond the depth, the
+// kernel's support). Without this, a sensor at the foot of a wall of water at rest read 23% low.
+template <int D>
+std::vector<std::size_t> WallSensor<D>::receivers(const std::vector<Near>& behind,
+                                                  const std::vector<Near>& front,
+                                                  double depth) const {
   const auto overlaps = [&](const Near& p, const Near& q) {
     const Vec<D> d = p.r - q.r;
     const double reach = 0.5 * (p.a + q.a) * (1.0 - 1e-9);
@@ -119,24 +119,34 @@ void WallSensor<D>::for_each_covered(const ParticleSet<D>& wall, double depth,
   for (std::size_t k = 0; k < behind.size(); ++k)
     corner[k] = std::any_of(front.begin(), front.end(),
                             [&](const Near& q) { return overlaps(behind[k], q); });
-  // The face particle each corner particle passes its force to: the nearest (ties: the first in
-  // the wall's order), none beyond the depth.
   std::vector<std::size_t> receiver(behind.size(), behind.size());
-  for (std::size_t c = 0; c < behind.size(); ++c) {
-    if (!corner[c]) continue;
+  for (std::size_t k = 0; k < behind.size(); ++k) {
+    if (!corner[k]) {
+      receiver[k] = k;
+      continue;
+    }
     double best = depth;
     for (std::size_t q = 0; q < behind.size(); ++q) {
-      const double d = (behind[q].r - behind[c].r).norm();
-      if (!corner[q] && d < best * (1.0 - 1e-12)) best = d, receiver[c] = q;
+      const double d = (behind[q].r - behind[k].r).norm();
+      if (!corner[q] && d < best * (1.0 - 1e-12)) best = d, receiver[k] = q;
     }
   }
+  return receiver;
+}
+
+template <int D>
+template <typename F>
+void WallSensor<D>::for_each_covered(const ParticleSet<D>& wall, double depth,
+                                     const Domain<D>& domain, std::size_t s, const F& f) const {
+  std::vector<Near> behind, front;
+  near_face(wall, depth, domain, s, behind, front);
+  const std::vector<std::size_t> receiver = receivers(behind, front, depth);
   for (std::size_t k = 0; k < behind.size(); ++k) {
-    if (corner[k]) continue;
+    if (receiver[k] != k) continue;  // a corner's particle, or none
     const Near& p = behind[k];
     const double area = covered(p.r + (-p.r.dot(normal_)) * normal_, p.a);
     if (!(area > 0.0)) continue;
     const double share = D == 2 ? p.a : p.a * p.a;
-    f(p.w, area, share);
     for (std::size_t c = 0; c < behind.size(); ++c)
       if (receiver[c] == k) f(behind[c].w, area, share);
   }

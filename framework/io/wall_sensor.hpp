@@ -60,7 +60,21 @@ class WallSensor {
   double face_area() const;  // length in 2D
 
  private:
-  // Calls f(w, covered area, share area) for every wall particle w behind sensor s's face.
+  struct Near {
+    std::size_t w;  // the wall particle
+    Vec<D> r;       // x_w - the face's centre (minimum image)
+    double a;       // its side, V_w^(1/D)
+  };
+  // The wall particles behind sensor s's plane within the depth, and those in front of it within
+  // their own side (the first layer of a wall that meets this one), near the face.
+  void near_face(const ParticleSet<D>& wall, double depth, const Domain<D>& domain, std::size_t s,
+                 std::vector<Near>& behind, std::vector<Near>& front) const;
+  // Per particle behind the plane, the one whose column of the face it counts in: itself, the
+  // nearest such particle for a concave corner's (wall_sensor.cpp), or behind.size() for none.
+  std::vector<std::size_t> receivers(const std::vector<Near>& behind,
+                                     const std::vector<Near>& front, double depth) const;
+  // Calls f(w, covered area, share area) for every wall particle w behind sensor s's face, and
+  // for each corner particle with its receiver's area and share.
   template <typename F>
   void for_each_covered(const ParticleSet<D>& wall, double depth, const Domain<D>& domain,
                         std::size_t s, const F& f) const;
