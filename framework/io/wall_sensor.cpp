@@ -141,14 +141,18 @@ void WallSensor<D>::for_each_covered(const ParticleSet<D>& wall, double depth,
   std::vector<Near> behind, front;
   near_face(wall, depth, domain, s, behind, front);
   const std::vector<std::size_t> receiver = receivers(behind, front, depth);
+  // Each face particle's corner particles, listed once (not a search per face particle).
+  std::vector<std::vector<std::size_t>> corners(behind.size());
+  for (std::size_t c = 0; c < behind.size(); ++c)
+    if (receiver[c] < behind.size() && receiver[c] != c) corners[receiver[c]].push_back(c);
   for (std::size_t k = 0; k < behind.size(); ++k) {
     if (receiver[k] != k) continue;  // a corner's particle, or none
     const Near& p = behind[k];
     const double area = covered(p.r + (-p.r.dot(normal_)) * normal_, p.a);
     if (!(area > 0.0)) continue;
     const double share = D == 2 ? p.a : p.a * p.a;
-    for (std::size_t c = 0; c < behind.size(); ++c)
-      if (receiver[c] == k) f(behind[c].w, area, share);
+    f(p.w, area, share);
+    for (std::size_t c : corners[k]) f(behind[c].w, area, share);
   }
 }
 

@@ -26,8 +26,12 @@ namespace cosph {
 // front of it. In a concave corner, where another wall's first layer lies in front of the plane,
 // the particles behind that layer are not behind the face: the water pushes them along the pairs'
 // diagonals, and each passes its force to the nearest particle behind the face (within `depth`),
-// so that a face at the wall's foot reads the push on its end. The face must lie on the wall (a
-// face over a wall's edge reads low), and a sensor that no wall particle covers reads NaN.
+// so that a face at the wall's foot reads the push on its end. The meeting wall must be in the
+// same particle set (a fluid's walls all are; a solid module's body is not, and a sensor at its
+// foot reads the corner's share low), and any wall particle of the set within one spacing in
+// front of the plane counts as one (a moving wall passing the face too, while it is there). The
+// face must lie on the wall (a face over a wall's edge reads low), and a sensor that no wall
+// particle covers reads NaN.
 template <int D>
 class WallSensor {
  public:
@@ -36,8 +40,9 @@ class WallSensor {
 
   const std::vector<Vec<D>>& centres() const { return centres_; }
 
-  // What sample() needs of the wall, per sensor: the wall particles behind its face and each
-  // one's weight, the covered area over its share's area. It depends only on the wall's
+  // What sample() needs of the wall, per sensor: the wall particles behind its face (and the
+  // corner particles that pass their force to them) and each one's weight, the covered area over
+  // its column's share. It depends only on the wall's
   // positions and volumes, so a static wall's is computed once.
   struct Coverage {
     std::vector<std::vector<std::pair<std::size_t, double>>> weights;
@@ -69,8 +74,9 @@ class WallSensor {
   // their own side (the first layer of a wall that meets this one), near the face.
   void near_face(const ParticleSet<D>& wall, double depth, const Domain<D>& domain, std::size_t s,
                  std::vector<Near>& behind, std::vector<Near>& front) const;
-  // Per particle behind the plane, the one whose column of the face it counts in: itself, the
-  // nearest such particle for a concave corner's (wall_sensor.cpp), or behind.size() for none.
+  // Per particle behind the plane, the particle whose column of the face it counts in: itself
+  // for a face particle, the nearest face particle for a corner particle (wall_sensor.cpp), or
+  // behind.size() for none.
   std::vector<std::size_t> receivers(const std::vector<Near>& behind,
                                      const std::vector<Near>& front, double depth) const;
   // Calls f(w, covered area, share area) for every wall particle w behind sensor s's face, and

@@ -325,7 +325,7 @@ const std::string kTankSensors = std::string(kTank) + R"yaml(  - name: sensors
     body: water_walls
     interval: 0.005
     sensor: {at: [[0.5, 0]], normal: [0, 1], diameter: 0.1}
-  - name: foot_sensors
+  - name: foot_sensor
     body: water_walls
     interval: 0.005
     sensor: {at: [[0, 0.025]], normal: [1, 0], diameter: 0.05}
@@ -360,7 +360,7 @@ TEST(Fluid, WallSensorsReadTheHydrostaticPressure) {
   }
   std::cout << "\n";
   EXPECT_NEAR(floor, 9810.0, 1.5 * 0.0032 * 9810.0);
-  const double foot = mean("foot_sensors", 1), corner_floor = mean("floor_corner_sensor", 1);
+  const double foot = mean("foot_sensor", 1), corner_floor = mean("floor_corner_sensor", 1);
   std::cout << "foot of the side wall " << foot << " (" << 1000.0 * 9.81 * 0.975
             << "), floor in the corner " << corner_floor << " (9810)\n";
   // Sensors one spacing wide in the corner, against the side wall's foot and on the floor next

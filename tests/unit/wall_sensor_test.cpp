@@ -156,39 +156,60 @@ TEST(WallSensor, ReadsTheColumnInFrontOfASmallFace3D) {
   EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.35)[0], 1.75, 1e-12);
 }
 
-// A concave corner in 2D: a side wall behind the plane x = 0 (normal -x, the water at x < 0) meets
-// a floor below y = 0 that runs under the water (x < 0) and on under the side wall (x > 0). The
-// particles under the side wall below y = 0 are behind the side wall's plane but not behind its
-// face: the floor's first layer lies in front of them. Whatever force along x the water puts on
-// them acts on the face's end, so the face's lowest column takes it; columns farther up do not.
-TEST(WallSensor, ACornersParticlesPassTheirPushToTheFacesEnd2D) {
-  std::vector<Vec<2>> x;
-  std::vector<Vec<2>> force;
-  for (int i = -10; i < 3; ++i)       // x = (i + 0.5) a: the floor (i < 0) and the corner (i >= 0)
-    for (int j = -3; j < 10; ++j) {   // y = (j + 0.5) a
-      if (i < 0 && j >= 0) continue;  // the water
-      x.emplace_back((i + 0.5) * kA, (j + 0.5) * kA);
-      // 1 on each face column's particle, 0.25 along x on each corner particle (and a push along
-      // y on everything, which a sensor facing -x must not read).
-      force.push_back(Vec<2>(i >= 0 && j >= 0 ? 1.0 : i >= 0 ? 0.25 : 0.0, -3.0) * kA);
-    }
-  ParticleSet<2> wall("wall");
+// A concave corner: a side wall behind the plane x = 0 (normal -x, the water at x < 0) meets a
+// floor below y = 0 (2D) or z = 0 (3D) that runs under the water (x < 0) and on under the side
+// wall (x > 0). The particles under the side wall below the floor's top are behind the side
+// wall's plane but not behind its face: the floor's first layer lies in front of them. Whatever
+// force along x the water puts on them acts on the face's end, so the face's lowest column takes
+// it; columns farther up do not. In 3D the wall extends along y over [-0.5, 0.5].
+template <int D>
+void check_corner() {
+  std::vector<Vec<D>> x, force;
+  const double share = D == 2 ? kA : kA * kA;
+  const int rows = D == 2 ? 1 : 10;
+  for (int k = 0; k < rows; ++k)
+    for (int i = -10; i < 3; ++i)      // x = (i + 0.5) a: the floor (i < 0) and the corner (i >= 0)
+      for (int j = -3; j < 10; ++j) {  // height (j + 0.5) a
+        if (i < 0 && j >= 0) continue;  // the water
+        Vec<D> p = Vec<D>::Zero();
+        p[0] = (i + 0.5) * kA;
+        p[D - 1] = (j + 0.5) * kA;
+        if constexpr (D == 3) p[1] = -0.5 + (k + 0.5) * kA;
+        x.push_back(p);
+        // 1 on each face column's particle, 0.25 along x on each corner particle (and a push
+        // down on everything, which a sensor facing -x must not read).
+        Vec<D> f = -3.0 * Vec<D>::Unit(D - 1);
+        f[0] = i >= 0 && j >= 0 ? 1.0 : i >= 0 ? 0.25 : 0.0;
+        force.push_back(share * f);
+      }
+  ParticleSet<D> wall("wall");
   wall.resize(x.size());
   wall.add_vector("position") = x;
-  wall.add_scalar("volume") = std::vector<double>(x.size(), kA * kA);
-  const Vec<2> normal(-1.0, 0.0);
-  // The lowest column (y in [0, a]): its three layers (3) and the corner's nine particles within
-  // the depth of 0.35 of it (the 3 x 3 block under it: 9 x 0.25), over the face's length a.
+  wall.add_scalar("volume") = std::vector<double>(x.size(), std::pow(kA, D));
+  const Vec<D> normal = -Vec<D>::Unit(0);
   const double depth = 0.35;
-  EXPECT_NEAR(WallSensor<2>({Vec<2>(0.0, 0.5 * kA)}, normal, kA).sample(wall, force, depth)[0],
+  auto at = [](double height) {  // a point of the plane x = 0, centred on a column in 3D
+    Vec<D> c = Vec<D>::Zero();
+    c[D - 1] = height;
+    if constexpr (D == 3) c[1] = 0.05;
+    return c;
+  };
+  // The lowest column (height in [0, a]): its three layers (3) and the corner's nine particles
+  // within the depth of 0.35 of it (the 3 x 3 block under it: 9 x 0.25).
+  EXPECT_NEAR(WallSensor<D>({at(0.5 * kA)}, normal, 0.5 * kA).sample(wall, force, depth)[0],
               3.0 + 9 * 0.25, 1e-12);
-  // A face over the two lowest columns shares the corner's push between them by area.
-  EXPECT_NEAR(WallSensor<2>({Vec<2>(0.0, kA)}, normal, 2 * kA).sample(wall, force, depth)[0],
-              (6.0 + 9 * 0.25) / 2.0, 1e-12);
   // A column two spacings up reads its own layers only.
-  EXPECT_NEAR(WallSensor<2>({Vec<2>(0.0, 2.5 * kA)}, normal, kA).sample(wall, force, depth)[0], 3.0,
+  EXPECT_NEAR(WallSensor<D>({at(2.5 * kA)}, normal, 0.5 * kA).sample(wall, force, depth)[0], 3.0,
               1e-12);
+  if constexpr (D == 2) {
+    // A face over the two lowest columns shares the corner's push between them by area.
+    EXPECT_NEAR(WallSensor<2>({at(kA)}, normal, 2 * kA).sample(wall, force, depth)[0],
+                (6.0 + 9 * 0.25) / 2.0, 1e-12);
+  }
 }
+
+TEST(WallSensor, ACornersParticlesPassTheirPushToTheFacesEnd2D) { check_corner<2>(); }
+TEST(WallSensor, ACornersParticlesPassTheirPushToTheFacesEnd3D) { check_corner<3>(); }
 
 }  // namespace
 }  // namespace cosph
