@@ -492,11 +492,8 @@ class SolidModule final : public StaticBodyModule<D> {
     if (quadrature_.offset.empty()) return material_.energy(F_[i], frame);
     const GradientSlopes<D> S = deformation_gradient_slopes<D>(pairs_, u, i);
     double sum = 0.0;
-    for (const Vec<D>& d : quadrature_.offset[i]) {
-      Mat<D> F_q = F_[i];
-      for (int c = 0; c < D; ++c) F_q.noalias() += d[c] * S[c];
-      sum += material_.energy(F_q, frame);
-    }
+    for (const Vec<D>& d : quadrature_.offset[i])
+      sum += material_.energy(gradient_at_offset<D>(F_[i], S, d), frame);
     return sum / EnergyQuadrature<D>::points;
   }
 

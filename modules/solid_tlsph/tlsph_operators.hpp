@@ -141,6 +141,14 @@ GradientSlopes<D> deformation_gradient_slopes(const ReferencePairs<D>& pairs,
   return S;
 }
 
+// F at the point X_i + d of particle i's dual cell: F_i + sum_c d_c S_c.
+template <int D>
+Mat<D> gradient_at_offset(const Mat<D>& F, const GradientSlopes<D>& S, const Vec<D>& d) {
+  Mat<D> F_d = F;
+  for (int c = 0; c < D; ++c) F_d.noalias() += d[c] * S[c];
+  return F_d;
+}
+
 // The energy of particle i integrated over its dual cell: P_iq = stress(F_iq) at the quadrature
 // points F_iq = F_i + sum_c d_qc S_c, returned as their mean P_i = sum_q w_q P_iq and first
 // moments T_i[c] = sum_q w_q d_qc P_iq, which is all the stress divergence needs; F_iq are kept
@@ -156,8 +164,7 @@ Mat<D> integrate_stress(const EnergyQuadrature<D>& quadrature, std::size_t i, co
   for (auto& t : T) t.setZero();
   for (int q = 0; q < EnergyQuadrature<D>::points; ++q) {
     const Vec<D>& d = quadrature.offset[i][q];
-    Mat<D> F_q = F;
-    for (int c = 0; c < D; ++c) F_q.noalias() += d[c] * S[c];
+    const Mat<D> F_q = gradient_at_offset<D>(F, S, d);
     if (Fq) (*Fq)[q] = F_q;
     const Mat<D> P_q = stress(F_q);
     mean.noalias() += w * P_q;
