@@ -6,7 +6,9 @@ the step count (N, or fewer if the scene ends sooner), one entry per module with
 `particles`), every coupler with its children, the outputs (vtp unless the scene turns it off,
 `probe:<name>` for every probe, in scene order), and for every probe the same values as the last
 row of its CSV file. Every probe CSV has the header `time,...` and one row per sample, times
-increasing. Usage: example_smoke.py COSPH SCENE.yaml OUTDIR [STEPS]
+increasing. With --coarsen F every module's body spacing is multiplied by F (`--set`): the
+sanitizer job runs the steady-state examples so, where one step is a whole load increment solved
+to equilibrium. Usage: example_smoke.py COSPH SCENE.yaml OUTDIR [STEPS] [--coarsen F]
 """
 import csv
 import json
@@ -55,17 +57,37 @@ def check_probe_csv(path, summary_values, name):
         check(same, f"probe {name}.{column}: CSV {value} vs summary {expected}")
 
 
+def spacing_overrides(scene, factor):
+    """`--set` arguments multiplying every module's body spacing by factor."""
+    overrides = []
+    for index, spec in enumerate(scene["modules"]):
+        kind = module_type(spec)
+        spacing = spec[kind].get("body", {}).get("spacing")
+        if spacing is not None:
+            overrides += ["--set", f"modules[{index}].{kind}.body.spacing={spacing * factor!r}"]
+    check(overrides, f"--coarsen {factor}: no module of the scene has a body spacing")
+    return overrides
+
+
 def main():
-    cosph, scene_file, outdir = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
-    steps = int(sys.argv[4]) if len(sys.argv) > 4 else 3
+    arguments = sys.argv[1:]
+    factor = None
+    if "--coarsen" in arguments:
+        at = arguments.index("--coarsen")
+        factor = float(arguments[at + 1])
+        del arguments[at:at + 2]
+    cosph, scene_file, outdir = arguments[0], Path(arguments[1]), Path(arguments[2])
+    steps = int(arguments[3]) if len(arguments) > 3 else 3
+    scene = yaml.safe_load(scene_file.read_text())
     shutil.rmtree(outdir, ignore_errors=True)
     command = [cosph, "run", str(scene_file), "--steps", str(steps), "--output", str(outdir),
                "--quiet", "--threads", "2"]
+    if factor is not None:
+        command += spacing_overrides(scene, factor)
     result = subprocess.run(command, capture_output=True, text=True, timeout=600)
     check(result.returncode == 0,
           f"{' '.join(command)} exited {result.returncode}\n{result.stdout}\n{result.stderr}")
 
-    scene = yaml.safe_load(scene_file.read_text())
     summary = json.loads((outdir / "summary.json").read_text())
 
     # N steps, or fewer where the scene ends sooner (a module without a step limit ends in one).

@@ -24,12 +24,12 @@ struct Apex {
 };
 
 // Runs a steady ventricle at the spacing (m) and returns the apex. The sanitizer job's reduced
-// run takes the coarse spacing and the load in small increments, so that its capped steps each
+// run takes 2 mm (835 particles) and the load in small increments, so that its capped steps each
 // converge quickly (the code paths are the same at any spacing).
 Apex steady_apex(const std::string& scene, double spacing, const std::string& tag) {
   std::ostringstream set;
   set.precision(17);
-  set << "modules[0].solid.body.spacing=" << (test::reduced_run() ? 1e-3 : spacing);
+  set << "modules[0].solid.body.spacing=" << (test::reduced_run() ? 2e-3 : spacing);
   std::vector<std::string> overrides{set.str(), "output.vtp=false", "checkpoint.at_end=false"};
   // The reduced run also takes the energy at the nodes: 2D times fewer stress evaluations keep
   // the sanitizer job's time (the dual-cell path runs under the sanitizers in the unit tests and
@@ -44,8 +44,8 @@ Apex steady_apex(const std::string& scene, double spacing, const std::string& ta
   options = test::with_step_cap(options);
   // Under the sanitizers each steady increment is a whole quasi-Newton solve. Five of them take
   // every path the 25 would (the first factorisation, the kept one in the increments after it, a
-  // refactorisation within an increment: 2 factorisations, 174 iterations) at 30% of the time
-  // (release: 9.2 s against 31.0 s; under the sanitizers the 25 took 459 s).
+  // refactorisation within an increment: 2 factorisations, 191 iterations at 2 mm). Release:
+  // 1.0 s at 2 mm, 9.9 s at 1 mm; under the sanitizers 1 mm took 114 s, and 25 increments 459 s.
   if (test::reduced_run()) options.max_steps = std::min<unsigned long long>(options.max_steps, 5);
   Simulation simulation(
       load_scene_file(std::string(COSPH_SOURCE_DIR) + "/examples/" + scene, overrides),
@@ -60,7 +60,7 @@ Apex steady_apex(const std::string& scene, double spacing, const std::string& ta
 
 TEST(LandVentricleValidation, InflationApexConvergesMonotonically) {
   const Apex coarse = steady_apex("solid_land_ventricle_static.yaml", 1e-3, "p2_1mm");
-  // A reduced run would repeat the first at the same spacing (315 s under the sanitizers).
+  // A reduced run would repeat the first at the same spacing.
   COSPH_SKIP_CHECKS_IF_REDUCED();
   const Apex fine = steady_apex("solid_land_ventricle_static.yaml", 0.75e-3, "p2_075mm");
   std::cout << "problem 2 apex z (mm): 1 mm endo " << coarse.endo << " epi " << coarse.epi
