@@ -159,6 +159,10 @@ class Study:
     order: Optional[int]
     comparisons: tuple = ()
     timeout: Optional[float] = None  # seconds a run may take (the runner's default if None)
+    # Runs that differ only in a setting that should not matter (e.g. output.interval: a step ends
+    # on each output time, so a chaotic flow takes another path): each point is the mean of one
+    # run per value, with the members' spread (single-valued quantities only).
+    ensemble: Optional[Axis] = None
 
     def points(self) -> list:
         """The cartesian product of the axes, then the explicit points."""
@@ -256,7 +260,8 @@ def load_study(path: Path) -> Study:
 def _parse_study(path: Path, root: Any) -> Study:
     _check_keys(root, "study", ("title", "description", "scene", "sweep", "quantity",
                                 "reference", "norm"),
-                ("name", "overrides", "threshold", "repeat", "order", "comparisons", "timeout"))
+                ("name", "overrides", "threshold", "repeat", "order", "comparisons", "timeout",
+                 "ensemble"))
     scene = (path.parent / _string(root["scene"], "scene")).resolve()
     if not scene.is_file():
         raise StudyError(f"scene: no such file: {scene}")
@@ -288,13 +293,28 @@ def _parse_study(path: Path, root: Any) -> Study:
         timeout = _number(timeout, "timeout")
         if not timeout > 0:
             raise StudyError(f"timeout: expected seconds > 0, got {timeout!r}")
+    ensemble = _parse_ensemble(root.get("ensemble"), quantity, norm)
     return Study(path=path.resolve(), name=_string(root.get("name", path.stem), "name"),
                  title=_string(root["title"], "title"),
                  description=_string(root["description"], "description"), scene=scene,
                  overrides=_overrides(root.get("overrides"), "overrides"), axes=axes,
                  explicit_points=explicit, quantity=quantity, reference=reference, norm=norm,
                  threshold=threshold, repeat=repeat, order=order, comparisons=comparisons,
-                 timeout=timeout)
+                 timeout=timeout, ensemble=ensemble)
+
+
+def _parse_ensemble(node: Any, quantity: Quantity, norm: str) -> Optional[Axis]:
+    if node is None:
+        return None
+    _check_keys(node, "ensemble", ("key", "values"), ("label",))
+    key = _string(node["key"], "ensemble.key")
+    values = node["values"]
+    if not isinstance(values, list) or len(values) < 2:
+        raise StudyError("ensemble.values: expected a list of two or more values")
+    if quantity.kind not in ("final",) + SCALAR_KINDS or norm not in ("max", "relative_at_point"):
+        raise StudyError(f"ensemble: needs a single-valued quantity (kind final or one of "
+                         f"{', '.join(SCALAR_KINDS)}) and norm max or relative_at_point")
+    return Axis(key, values, _string(node.get("label", key.rsplit(".", 1)[-1]), "ensemble.label"))
 
 
 def _parse_comparisons(node: Any, base: Path, quantity: Quantity) -> tuple:
@@ -666,6 +686,7 @@ class PointResult:
     sample: Optional[Sample] = None
     reference_values: Optional[np.ndarray] = None
     arrivals: Optional[tuple] = None  # (simulated, reference) arrival times
+    members: tuple = ()  # an ensemble point's member values (the point's value is their mean)
     reused: bool = False  # taken from the run cache, not run by this invocation
 
 
@@ -1044,6 +1065,42 @@ def compare(study: Study, out_dir: Path, result: PointResult) -> None:
         result.error = float(abs(s[-1] - r[-1]) / abs(r[-1]))
 
 
+def ensemble_members(study: Study, point: Point) -> list:
+    """The point once per ensemble value (the same index: they are one point)."""
+    axis = study.ensemble
+    return [Point(point.index, f"{point.label}, {axis.label}={format_value(value)}",
+                  {**point.overrides, axis.key: value}, point.axis_values)
+            for value in axis.values]
+
+
+def combine_members(study: Study, point: Point, members: list) -> PointResult:
+    """An ensemble point: the mean of its members' values, compared with the reference as one
+    run would be; its cost is the mean member's. A failed member fails the point."""
+    result = PointResult(point)
+    for j, member in enumerate(members):
+        if member.status != "ok":
+            result.status, result.message = member.status, f"member {j}: {member.message}"
+            return result
+    values = np.array([m.sample.values[-1] for m in members])
+    mean = float(values.mean())
+    first = members[0]
+    result.sample = Sample(np.array([mean]), first.sample.variables, first.sample.abscissa,
+                           first.sample.abscissa_name, first.sample.field_name)
+    result.reference_values = first.reference_values
+    reference = float(first.reference_values[-1])
+    result.error = abs(mean - reference)
+    if study.norm == "relative_at_point":
+        result.error /= abs(reference)
+    result.members = tuple(float(v) for v in values)
+    for name in ("wall_seconds", "cpu_seconds", "particles", "steps",
+                 "particle_steps_per_second", "threads"):
+        setattr(result, name, float(np.mean([getattr(m, name) for m in members])))
+    result.reused = all(m.reused for m in members)
+    result.message = (f"mean of {len(values)} runs ({study.ensemble.label}), values "
+                      f"{values.min():.4g} to {values.max():.4g}")
+    return result
+
+
 # ---- Outputs ----------------------------------------------------------------------------------
 
 RESULT_COLUMNS = ("wall_seconds", "cpu_seconds", "particles", "steps",
@@ -1264,9 +1321,16 @@ def _plot_final_values(ax, study: Study, results: list) -> None:
     for group in _plot_groups(study, results):
         ok = [r for r in group.members if r.status == "ok" and r.sample is not None]
         if ok:
-            ax.plot([r.particles for r in ok], [r.sample.values[-1] for r in ok],
-                    "o-" if group.connect else "o",
-                    label=f"cosph, {group.name}" if group.name else "cosph")
+            lines = ax.plot([r.particles for r in ok], [r.sample.values[-1] for r in ok],
+                            "o-" if group.connect else "o",
+                            label=f"cosph, {group.name}" if group.name else "cosph")
+            spread = [r for r in ok if r.members]
+            if spread:  # an ensemble: its members' range
+                means = np.array([r.sample.values[-1] for r in spread])
+                low = means - np.array([min(r.members) for r in spread])
+                high = np.array([max(r.members) for r in spread]) - means
+                ax.errorbar([r.particles for r in spread], means, yerr=[low, high], fmt="none",
+                            ecolor=lines[0].get_color(), capsize=4)
             reference = ok[0].reference_values[-1]
     ax.axhline(reference, color="k", lw=1.4, label="reference")
     if study.reference.band is not None:
@@ -1315,8 +1379,14 @@ def run_study(study: Study, cosph: Path, out_dir: Path, repeat: int, timeout: fl
     points = study.points()
     results = []
     for point in points:
-        result = run_point(study, point, cosph, out_dir / "points" / str(point.index), repeat,
-                           timeout, cache, refresh)
+        point_dir = out_dir / "points" / str(point.index)
+        if study.ensemble is None:
+            result = run_point(study, point, cosph, point_dir, repeat, timeout, cache, refresh)
+        else:
+            members = [run_point(study, member, cosph, point_dir / str(j), repeat, timeout,
+                                 cache, refresh)
+                       for j, member in enumerate(ensemble_members(study, point))]
+            result = combine_members(study, point, members)
         results.append(result)
         log(f"[{point.index + 1}/{len(points)}] {point.label}: {result.status}"
             + (f" ({result.message})" if result.message else "")

@@ -120,9 +120,17 @@ def setup_lines(study: studies.Study, run: studies.StudyRun, doc_dir: Path) -> l
         extra = ", ".join(f"`{k}={studies.format_value(v)}`" for k, v in overrides.items())
         lines.append(f"- **Point {label}:** {extra}")
     threads = sorted({int(r.threads) for r in run.results if r.threads == r.threads})
-    lines.append(f"- **Points:** {len(run.results)}, each run {run.repeat} time(s) on "
-                 f"{'/'.join(map(str, threads)) or '?'} thread(s); the table gives the fastest "
-                 "run's wall time")
+    if study.ensemble is None:
+        lines.append(f"- **Points:** {len(run.results)}, each run {run.repeat} time(s) on "
+                     f"{'/'.join(map(str, threads)) or '?'} thread(s); the table gives the "
+                     "fastest run's wall time")
+    else:
+        axis = study.ensemble
+        values = ", ".join(studies.format_value(v) for v in axis.values)
+        lines.append(f"- **Ensemble:** each point is the mean of {len(axis.values)} runs, "
+                     f"`{axis.key}` = {values}; the table gives the members' range and their "
+                     f"mean wall time ({'/'.join(map(str, threads)) or '?'} thread(s))")
+    return lines
     return lines
 
 

@@ -158,5 +158,67 @@ norm: {norm}
             self.load(extra="timeout: long")
 
 
+class Ensemble(unittest.TestCase):
+    """A point of an ensemble study is the mean of one run per ensemble value, compared with the
+    reference as one run would be; its members' values are kept for the range."""
+
+    def load(self, extra):
+        return ComparisonsAndBand().load(extra=extra)
+
+    def member(self, point, value, reference=4.0, wall=2.0):
+        result = study.PointResult(point, wall_seconds=wall, cpu_seconds=wall, particles=100.0,
+                                   steps=10.0, particle_steps_per_second=500.0, threads=2.0)
+        t = np.array([1.0])
+        result.sample = study.Sample(np.array([value]), {"t": t}, t, "time", "z")
+        result.reference_values = np.array([reference])
+        return result
+
+    def test_members_differ_in_the_ensemble_key_only(self):
+        loaded = self.load("ensemble: {key: output.interval, values: [0.5, 0.7], label: out}")
+        point = loaded.points()[1]
+        members = study.ensemble_members(loaded, point)
+        self.assertEqual([m.overrides for m in members],
+                         [{"a": 2, "output.interval": 0.5}, {"a": 2, "output.interval": 0.7}])
+        self.assertEqual([m.index for m in members], [1, 1])
+        self.assertEqual(members[1].label, "a=2, out=0.7")
+
+    def test_point_is_the_members_mean_and_keeps_their_range(self):
+        loaded = self.load("ensemble: {key: output.interval, values: [0.5, 0.7, 0.9]}")
+        point = loaded.points()[0]
+        members = [self.member(point, v, wall=w) for v, w in ((4.2, 1.0), (4.6, 2.0), (4.4, 3.0))]
+        combined = study.combine_members(loaded, point, members)
+        self.assertEqual(combined.status, "ok")
+        self.assertAlmostEqual(combined.sample.values[-1], 4.4)
+        self.assertAlmostEqual(combined.error, 0.4 / 4.0)  # relative_at_point, of the mean
+        self.assertEqual(combined.members, (4.2, 4.6, 4.4))
+        self.assertAlmostEqual(combined.wall_seconds, 2.0)
+        self.assertIn("values 4.2 to 4.6", combined.message)
+
+    def test_a_failed_member_fails_the_point(self):
+        loaded = self.load("ensemble: {key: output.interval, values: [0.5, 0.7]}")
+        point = loaded.points()[0]
+        members = [self.member(point, 4.2), study.PointResult(point, "diverged", "NaN at t = 3")]
+        combined = study.combine_members(loaded, point, members)
+        self.assertEqual(combined.status, "diverged")
+        self.assertEqual(combined.message, "member 1: NaN at t = 3")
+        self.assertTrue(np.isnan(combined.error))
+
+    def test_refuses_one_value_and_a_time_series(self):
+        with self.assertRaisesRegex(study.StudyError, "ensemble.values: expected a list of two"):
+            self.load("ensemble: {key: output.interval, values: [0.5]}")
+        with self.assertRaisesRegex(study.StudyError, "ensemble.*vlaues.*unknown key"):
+            self.load("ensemble: {key: output.interval, vlaues: [0.5, 0.7]}")
+        with tempfile.TemporaryDirectory() as directory:
+            root = Path(directory)
+            (root / "scene.yaml").write_text(ComparisonsAndBand.SCENE)
+            text = ComparisonsAndBand.STUDY.format(
+                kind="time_series", norm="l2_time", band="",
+                extra="ensemble: {key: output.interval, values: [0.5, 0.7]}")
+            (root / "study.yaml").write_text(text.replace("comparisons:", "# comparisons:"))
+            with self.assertRaisesRegex(study.StudyError,
+                                        "ensemble: needs a single-valued quantity"):
+                study.load_study(root / "study.yaml")
+
+
 if __name__ == "__main__":
     unittest.main()
