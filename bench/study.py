@@ -294,6 +294,11 @@ def _parse_study(path: Path, root: Any) -> Study:
         if not timeout > 0:
             raise StudyError(f"timeout: expected seconds > 0, got {timeout!r}")
     ensemble = _parse_ensemble(root.get("ensemble"), quantity, norm)
+    fixed = [a.key for a in axes] + [k for _, extra in explicit for k in extra]
+    if ensemble is not None and (ensemble.key in fixed or ensemble.key in (root.get("overrides")
+                                                                            or {})):
+        raise StudyError(f"ensemble.key: '{ensemble.key}' is also set by the sweep or the "
+                         "overrides; an ensemble varies a setting nothing else fixes")
     return Study(path=path.resolve(), name=_string(root.get("name", path.stem), "name"),
                  title=_string(root["title"], "title"),
                  description=_string(root["description"], "description"), scene=scene,
@@ -1112,13 +1117,14 @@ def write_results_csv(path: Path, study: Study, results: list) -> None:
     with open(path, "w", newline="") as stream:
         writer = csv.writer(stream)
         writer.writerow(["point", "label", *axis_labels, "overrides", "status", "message",
-                         "error", *RESULT_COLUMNS])
+                         "error", *RESULT_COLUMNS, "members"])
         for r in results:
             overrides = "; ".join(f"{k}={format_value(v)}" for k, v in r.point.overrides.items())
             writer.writerow([r.point.index, r.point.label,
                              *(format_value(r.point.axis_values.get(a, "")) for a in axis_labels),
                              overrides, r.status, r.message, repr(r.error),
-                             *(repr(getattr(r, name)) for name in RESULT_COLUMNS)])
+                             *(repr(getattr(r, name)) for name in RESULT_COLUMNS),
+                             "; ".join(repr(v) for v in r.members)])
 
 
 def best_result(results: list) -> Optional[PointResult]:

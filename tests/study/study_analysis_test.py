@@ -193,6 +193,11 @@ class Ensemble(unittest.TestCase):
         self.assertEqual(combined.members, (4.2, 4.6, 4.4))
         self.assertAlmostEqual(combined.wall_seconds, 2.0)
         self.assertIn("values 4.2 to 4.6", combined.message)
+        with tempfile.TemporaryDirectory() as directory:
+            path = Path(directory) / "results.csv"
+            study.write_results_csv(path, loaded, [combined])
+            row = path.read_text().splitlines()[1]
+            self.assertTrue(row.endswith("4.2; 4.6; 4.4"), row)
 
     def test_a_failed_member_fails_the_point(self):
         loaded = self.load("ensemble: {key: output.interval, values: [0.5, 0.7]}")
@@ -206,6 +211,10 @@ class Ensemble(unittest.TestCase):
     def test_refuses_one_value_and_a_time_series(self):
         with self.assertRaisesRegex(study.StudyError, "ensemble.values: expected a list of two"):
             self.load("ensemble: {key: output.interval, values: [0.5]}")
+        with self.assertRaisesRegex(study.StudyError, "ensemble.key: 'a' is also set by"):
+            self.load("ensemble: {key: a, values: [0.5, 0.7]}")
+        with self.assertRaisesRegex(study.StudyError, "ensemble.key: 'b' is also set by"):
+            self.load("overrides: {b: 1}\nensemble: {key: b, values: [0.5, 0.7]}")
         with self.assertRaisesRegex(study.StudyError, "ensemble.*vlaues.*unknown key"):
             self.load("ensemble: {key: output.interval, vlaues: [0.5, 0.7]}")
         with tempfile.TemporaryDirectory() as directory:
