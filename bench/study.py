@@ -293,16 +293,16 @@ def _parse_study(path: Path, root: Any) -> Study:
         timeout = _number(timeout, "timeout")
         if not timeout > 0:
             raise StudyError(f"timeout: expected seconds > 0, got {timeout!r}")
+    overrides = _overrides(root.get("overrides"), "overrides")
     ensemble = _parse_ensemble(root.get("ensemble"), quantity, norm)
-    fixed = [a.key for a in axes] + [k for _, extra in explicit for k in extra]
-    if ensemble is not None and (ensemble.key in fixed or ensemble.key in (root.get("overrides")
-                                                                            or {})):
+    fixed = [a.key for a in axes] + [k for _, extra in explicit for k in extra] + list(overrides)
+    if ensemble is not None and ensemble.key in fixed:
         raise StudyError(f"ensemble.key: '{ensemble.key}' is also set by the sweep or the "
                          "overrides; an ensemble varies a setting nothing else fixes")
     return Study(path=path.resolve(), name=_string(root.get("name", path.stem), "name"),
                  title=_string(root["title"], "title"),
                  description=_string(root["description"], "description"), scene=scene,
-                 overrides=_overrides(root.get("overrides"), "overrides"), axes=axes,
+                 overrides=overrides, axes=axes,
                  explicit_points=explicit, quantity=quantity, reference=reference, norm=norm,
                  threshold=threshold, repeat=repeat, order=order, comparisons=comparisons,
                  timeout=timeout, ensemble=ensemble)
@@ -316,6 +316,8 @@ def _parse_ensemble(node: Any, quantity: Quantity, norm: str) -> Optional[Axis]:
     values = node["values"]
     if not isinstance(values, list) or len(values) < 2:
         raise StudyError("ensemble.values: expected a list of two or more values")
+    if len({format_value(v) for v in values}) != len(values):
+        raise StudyError("ensemble.values: a value is listed twice (it would count twice)")
     if quantity.kind not in ("final",) + SCALAR_KINDS or norm not in ("max", "relative_at_point"):
         raise StudyError(f"ensemble: needs a single-valued quantity (kind final or one of "
                          f"{', '.join(SCALAR_KINDS)}) and norm max or relative_at_point")
@@ -720,6 +722,8 @@ def check_first_point(study: Study, cosph: Path) -> None:
     """Validates the scene with the first point's overrides (`cosph check`), so that a misspelt
     sweep key stops the study at once instead of failing every point."""
     point = study.points()[0]
+    if study.ensemble is not None:
+        point = ensemble_members(study, point)[0]
     command = cosph_command(cosph, study.scene, point.overrides, Path("."), action="check")
     done = subprocess.run(command, capture_output=True, text=True, check=False)
     if done.returncode == 2:
@@ -1089,6 +1093,12 @@ def combine_members(study: Study, point: Point, members: list) -> PointResult:
     values = np.array([m.sample.values[-1] for m in members])
     mean = float(values.mean())
     first = members[0]
+    references = np.array([m.reference_values[-1] for m in members])
+    if not np.allclose(references, references[0], rtol=1e-12, atol=0.0):
+        result.status = "failed"
+        result.message = (f"the members' references differ ({references.min():.6g} to "
+                          f"{references.max():.6g}): their mean has no one reference")
+        return result
     result.sample = Sample(np.array([mean]), first.sample.variables, first.sample.abscissa,
                            first.sample.abscissa_name, first.sample.field_name)
     result.reference_values = first.reference_values
@@ -1101,8 +1111,10 @@ def combine_members(study: Study, point: Point, members: list) -> PointResult:
                  "particle_steps_per_second", "threads"):
         setattr(result, name, float(np.mean([getattr(m, name) for m in members])))
     result.reused = all(m.reused for m in members)
+    reused = sum(m.reused for m in members)
     result.message = (f"mean of {len(values)} runs ({study.ensemble.label}), values "
-                      f"{values.min():.4g} to {values.max():.4g}")
+                      f"{values.min():.4g} to {values.max():.4g}"
+                      + (f"; {reused} reused" if reused else ""))
     return result
 
 
@@ -1333,8 +1345,9 @@ def _plot_final_values(ax, study: Study, results: list) -> None:
             spread = [r for r in ok if r.members]
             if spread:  # an ensemble: its members' range
                 means = np.array([r.sample.values[-1] for r in spread])
-                low = means - np.array([min(r.members) for r in spread])
-                high = np.array([max(r.members) for r in spread]) - means
+                # The mean of equal members can round past them: no negative bar.
+                low = np.maximum(means - np.array([min(r.members) for r in spread]), 0.0)
+                high = np.maximum(np.array([max(r.members) for r in spread]) - means, 0.0)
                 ax.errorbar([r.particles for r in spread], means, yerr=[low, high], fmt="none",
                             ecolor=lines[0].get_color(), capsize=4)
             reference = ok[0].reference_values[-1]

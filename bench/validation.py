@@ -129,8 +129,8 @@ def setup_lines(study: studies.Study, run: studies.StudyRun, doc_dir: Path) -> l
         values = ", ".join(studies.format_value(v) for v in axis.values)
         lines.append(f"- **Ensemble:** each point is the mean of {len(axis.values)} runs, "
                      f"`{axis.key}` = {values}; the table gives the members' range and their "
-                     f"mean wall time ({'/'.join(map(str, threads)) or '?'} thread(s))")
-    return lines
+                     f"mean wall time, each member run {run.repeat} time(s) (the fastest "
+                     f"counts) on {'/'.join(map(str, threads)) or '?'} thread(s)")
     return lines
 
 

@@ -62,9 +62,10 @@ def spacing_overrides(scene, factor):
     overrides = []
     for index, spec in enumerate(scene["modules"]):
         kind = module_type(spec)
-        spacing = spec[kind].get("body", {}).get("spacing")
-        if spacing is not None:
-            overrides += ["--set", f"modules[{index}].{kind}.body.spacing={spacing * factor!r}"]
+        spacing = ((spec[kind] or {}).get("body") or {}).get("spacing")
+        if spacing is not None:  # float(): YAML reads 1e-3 (no point) as a string
+            value = float(spacing) * factor
+            overrides += ["--set", f"modules[{index}].{kind}.body.spacing={value!r}"]
     check(overrides, f"--coarsen {factor}: no module of the scene has a body spacing")
     return overrides
 
@@ -74,6 +75,7 @@ def main():
     factor = None
     if "--coarsen" in arguments:
         at = arguments.index("--coarsen")
+        check(at + 1 < len(arguments), "--coarsen needs a factor")
         factor = float(arguments[at + 1])
         del arguments[at:at + 2]
     cosph, scene_file, outdir = arguments[0], Path(arguments[1]), Path(arguments[2])

@@ -199,6 +199,22 @@ class Ensemble(unittest.TestCase):
             row = path.read_text().splitlines()[1]
             self.assertTrue(row.endswith("4.2; 4.6; 4.4"), row)
 
+    def test_members_that_agree_plot_without_negative_bars(self):
+        # The mean of three 0.1s is 0.10000000000000002, above every member.
+        loaded = self.load("ensemble: {key: output.interval, values: [0.5, 0.7, 0.9]}")
+        point = loaded.points()[0]
+        combined = study.combine_members(loaded, point, [self.member(point, 0.1)] * 3)
+        with tempfile.TemporaryDirectory() as directory:
+            study.write_plot(Path(directory) / "plot.png", loaded, [combined])
+
+    def test_members_with_other_references_fail_the_point(self):
+        loaded = self.load("ensemble: {key: output.interval, values: [0.5, 0.7]}")
+        point = loaded.points()[0]
+        combined = study.combine_members(
+            loaded, point, [self.member(point, 4.2), self.member(point, 4.2, reference=4.1)])
+        self.assertEqual(combined.status, "failed")
+        self.assertIn("references differ", combined.message)
+
     def test_a_failed_member_fails_the_point(self):
         loaded = self.load("ensemble: {key: output.interval, values: [0.5, 0.7]}")
         point = loaded.points()[0]
@@ -215,6 +231,10 @@ class Ensemble(unittest.TestCase):
             self.load("ensemble: {key: a, values: [0.5, 0.7]}")
         with self.assertRaisesRegex(study.StudyError, "ensemble.key: 'b' is also set by"):
             self.load("overrides: {b: 1}\nensemble: {key: b, values: [0.5, 0.7]}")
+        with self.assertRaisesRegex(study.StudyError, "ensemble.values: a value is listed twice"):
+            self.load("ensemble: {key: output.interval, values: [0.5, 0.7, 0.5]}")
+        with self.assertRaisesRegex(study.StudyError, "overrides"):
+            self.load("overrides: 5\nensemble: {key: b, values: [0.5, 0.7]}")
         with self.assertRaisesRegex(study.StudyError, "ensemble.*vlaues.*unknown key"):
             self.load("ensemble: {key: output.interval, vlaues: [0.5, 0.7]}")
         with tempfile.TemporaryDirectory() as directory:

@@ -99,9 +99,9 @@ TEST(LandVentricleValidation, InflationApexConvergesMonotonically) {
 // tenth the endocardium wrinkles at the particle scale (largest measure 2.75 here); the active
 // tension on the axis acts through the fibres' in-wall average (fibre_undefined_in_wall).
 TEST(LandVentricleValidation, ActiveContractionRaisesTheApex) {
-  // The sanitizer job's reduced run would take 25 small increments at 1 mm (about 5 min, as
-  // problem 2's above); its code paths are problem 2's with the fibres and active tension, which
-  // the example's smoke run takes through one increment there.
+  // Not in the sanitizer job's reduced run: its code paths are problem 2's with the fibres and
+  // active tension, which the example's smoke run there takes through one increment (at 2 mm)
+  // and the steady active ventricle's determinism test through two.
   if (test::reduced_run()) GTEST_SKIP() << "reduced run: problem 3 runs in the release job only";
   const Apex coarse = steady_apex("solid_land_ventricle_active_static.yaml", 1e-3, "p3_1mm");
   std::cout << "problem 3 apex z (mm) at 1 mm: endo " << coarse.endo << " epi " << coarse.epi
