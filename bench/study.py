@@ -810,8 +810,7 @@ def run_point(study: Study, point: Point, cosph: Path, out_dir: Path, repeat: in
             best_summary = summary
     if cache is not None and not result.reused:
         (out_dir / "summary.json").write_text(json.dumps(best_summary))
-    for name in ("wall_seconds", "cpu_seconds", "particles", "steps",
-                 "particle_steps_per_second", "threads"):
+    for name in RESULT_COLUMNS:
         setattr(result, name, float(best_summary.get(name, math.nan)))
     try:
         compare(study, out_dir, result)
@@ -1065,13 +1064,19 @@ def compare(study: Study, out_dir: Path, result: PointResult) -> None:
         # discontinuous start): nothing to compare with. Said in the table, not hidden.
         result.message = (f"{np.count_nonzero(~usable)} of {usable.size} samples without a "
                           "finite reference, left out")
-    s, r = sample.values[usable], reference[usable]
-    if study.norm == "max":
-        result.error = float(np.max(np.abs(s - r)))
-    elif study.norm in ("l2_relative", "l2_time"):
-        result.error = float(np.sqrt(np.sum((s - r) ** 2) / np.sum(r ** 2)))
-    elif study.norm == "relative_at_point":
-        result.error = float(abs(s[-1] - r[-1]) / abs(r[-1]))
+    result.error = norm_error(study.norm, sample.values[usable], reference[usable])
+
+
+def norm_error(norm: str, s: np.ndarray, r: np.ndarray) -> float:
+    """The error of simulated values s against reference values r in a study's norm (all but
+    arrival_time, which compares crossing times)."""
+    if norm == "max":
+        return float(np.max(np.abs(s - r)))
+    if norm in ("l2_relative", "l2_time"):
+        return float(np.sqrt(np.sum((s - r) ** 2) / np.sum(r ** 2)))
+    if norm == "relative_at_point":
+        return float(abs(s[-1] - r[-1]) / abs(r[-1]))
+    raise ValueError(f"norm_error: no value norm {norm!r}")
 
 
 def ensemble_members(study: Study, point: Point) -> list:
@@ -1102,13 +1107,9 @@ def combine_members(study: Study, point: Point, members: list) -> PointResult:
     result.sample = Sample(np.array([mean]), first.sample.variables, first.sample.abscissa,
                            first.sample.abscissa_name, first.sample.field_name)
     result.reference_values = first.reference_values
-    reference = float(first.reference_values[-1])
-    result.error = abs(mean - reference)
-    if study.norm == "relative_at_point":
-        result.error /= abs(reference)
+    result.error = norm_error(study.norm, result.sample.values, first.reference_values[-1:])
     result.members = tuple(float(v) for v in values)
-    for name in ("wall_seconds", "cpu_seconds", "particles", "steps",
-                 "particle_steps_per_second", "threads"):
+    for name in RESULT_COLUMNS:
         setattr(result, name, float(np.mean([getattr(m, name) for m in members])))
     result.reused = all(m.reused for m in members)
     reused = sum(m.reused for m in members)

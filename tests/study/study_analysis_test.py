@@ -225,18 +225,19 @@ class Ensemble(unittest.TestCase):
         self.assertTrue(np.isnan(combined.error))
 
     def test_refuses_one_value_and_a_time_series(self):
-        with self.assertRaisesRegex(study.StudyError, "ensemble.values: expected a list of two"):
-            self.load("ensemble: {key: output.interval, values: [0.5]}")
-        with self.assertRaisesRegex(study.StudyError, "ensemble.key: 'a' is also set by"):
-            self.load("ensemble: {key: a, values: [0.5, 0.7]}")
-        with self.assertRaisesRegex(study.StudyError, "ensemble.key: 'b' is also set by"):
-            self.load("overrides: {b: 1}\nensemble: {key: b, values: [0.5, 0.7]}")
-        with self.assertRaisesRegex(study.StudyError, "ensemble.values: a value is listed twice"):
-            self.load("ensemble: {key: output.interval, values: [0.5, 0.7, 0.5]}")
-        with self.assertRaisesRegex(study.StudyError, "overrides"):
-            self.load("overrides: 5\nensemble: {key: b, values: [0.5, 0.7]}")
-        with self.assertRaisesRegex(study.StudyError, "ensemble.*vlaues.*unknown key"):
-            self.load("ensemble: {key: output.interval, vlaues: [0.5, 0.7]}")
+        refused = [
+            ("ensemble.values: expected a list of two", "ensemble: {key: o, values: [0.5]}"),
+            ("ensemble.key: 'a' is also set by", "ensemble: {key: a, values: [0.5, 0.7]}"),
+            ("ensemble.key: 'b' is also set by",
+             "overrides: {b: 1}\nensemble: {key: b, values: [0.5, 0.7]}"),
+            ("ensemble.values: a value is listed twice",
+             "ensemble: {key: o, values: [0.5, 0.7, 0.5]}"),
+            ("overrides", "overrides: 5\nensemble: {key: b, values: [0.5, 0.7]}"),
+            ("ensemble.*vlaues.*unknown key", "ensemble: {key: o, vlaues: [0.5, 0.7]}"),
+        ]
+        for message, extra in refused:
+            with self.subTest(extra=extra), self.assertRaisesRegex(study.StudyError, message):
+                self.load(extra)
         with tempfile.TemporaryDirectory() as directory:
             root = Path(directory)
             (root / "scene.yaml").write_text(ComparisonsAndBand.SCENE)
