@@ -32,6 +32,15 @@ Mat<D> orthonormal_frame(const Vec<D>& f_in, const Vec<D>& s_in) {
   return frame;
 }
 
+Mat<3> frame_turned_about_sheet(const Mat<3>& frame, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  Mat<3> turned;
+  turned.col(0) = c * frame.col(0) + s * frame.col(2);
+  turned.col(1) = frame.col(1);
+  turned.col(2) = -s * frame.col(0) + c * frame.col(2);
+  return turned;
+}
+
 Mat<3> land_ellipsoid_frame(const proto::EllipsoidFibreRule& rule, const Vec<3>& x) {
   const double rho = std::hypot(x[0], x[1]);
   auto short_radius = [&](double t) {

@@ -232,8 +232,8 @@ class SolidModule final : public StaticBodyModule<D> {
       if (energy) particles_.scalar("strain_energy")[i] = strain_energy(i, frame, u);
       if (fibre) {
         const Mat<D> E = 0.5 * (F_[i].transpose() * F_[i] - Mat<D>::Identity());
-        const Mat<D> local = frame.transpose() * E * frame;
-        particles_.vector("fibre_strain")[i] = local.diagonal();
+        particles_.vector("fibre_strain")[i] = over_fibres(
+            i, frame, [&](const Mat<D>& f) { return Vec<D>((f.transpose() * E * f).diagonal()); });
       }
     });
   }
@@ -454,13 +454,30 @@ class SolidModule final : public StaticBodyModule<D> {
     return std::sqrt(1.5 * (dev.array() * dev.array()).sum());
   }
 
+  bool fibre_undefined(std::size_t i) const {
+    return !fibre_undefined_.empty() && fibre_undefined_[i];
+  }
+
+  // What depends on the fibre at particle i: value(frame), or where the fibre rule leaves f0
+  // undefined within the wall its mean over the wall's fibres (mean_over_wall_fibres). The mean of
+  // the law's energies is an energy whose stress is the mean of the stresses, so such a particle
+  // stays hyperelastic and the tangent's differences of P follow it.
+  template <class Value>
+  auto over_fibres(std::size_t i, const Mat<D>& frame, Value&& value) const {
+    if constexpr (D == 3)
+      if (fibre_undefined(i)) return mean_over_wall_fibres(frame, value);
+    return value(frame);
+  }
+
   // P of particle i: the law plus the active stress T_a F A0, A0 = f0 (x) f0; where the fibre
-  // rule leaves f0 undefined within the wall, A0 is its average over the wall's directions,
-  // (I - s0 (x) s0) / 2 (fibre_undefined_in_wall), not one arbitrary direction's pull.
+  // rule leaves f0 undefined within the wall, both are their means over the wall's fibres: the
+  // law's by over_fibres, A0's in closed form, (I - s0 (x) s0) / 2 (fibre_undefined_in_wall).
   Mat<D> first_piola(std::size_t i, const Mat<D>& F, const Mat<D>& frame) const {
-    Mat<D> P = material_.stress(F, frame);
+    Mat<D> P = material_.anisotropic()
+                   ? over_fibres(i, frame, [&](const Mat<D>& f) { return material_.stress(F, f); })
+                   : material_.stress(F, frame);
     if (active_ && (*active_)[i] != 0.0) {
-      if (!fibre_undefined_.empty() && fibre_undefined_[i]) {
+      if (fibre_undefined(i)) {
         const Vec<D> s0 = frame.col(1);
         P.noalias() += 0.5 * (*active_)[i] * (F - (F * s0) * s0.transpose());
       } else {
@@ -489,11 +506,13 @@ class SolidModule final : public StaticBodyModule<D> {
   // W per unit reference volume at displacements u (F_ holds their F): at the particle, or the
   // mean over its cell's points.
   double strain_energy(std::size_t i, const Mat<D>& frame, const std::vector<Vec<D>>& u) const {
-    if (quadrature_.offset.empty()) return material_.energy(F_[i], frame);
+    auto energy = [&](const Mat<D>& F) {
+      return over_fibres(i, frame, [&](const Mat<D>& f) { return material_.energy(F, f); });
+    };
+    if (quadrature_.offset.empty()) return energy(F_[i]);
     const GradientSlopes<D> S = deformation_gradient_slopes<D>(pairs_, u, i);
     double sum = 0.0;
-    for (const Vec<D>& d : quadrature_.offset[i])
-      sum += material_.energy(gradient_at_offset<D>(F_[i], S, d), frame);
+    for (const Vec<D>& d : quadrature_.offset[i]) sum += energy(gradient_at_offset<D>(F_[i], S, d));
     return sum / EnergyQuadrature<D>::points;
   }
 
