@@ -73,65 +73,100 @@ namespace {
 
 template <int D>
 using Block = Mat<D>;
-template <int D>
-using Contracted = Eigen::Matrix<double, D * D, D>;
+// The material stiffness in moment form. At point q of particle i's energy quadrature, dF_i =
+// sum_k du_k (x) c_ik(q) with c_ik(q) = c_ik + h_ik d_q = G_ik e_q, where G_ik = [c_ik | h_ik] is
+// D x E and e_q = (1, d_q) (E = D + 1; without a quadrature the one point is the particle, G_ik =
+// c_ik and E = 1). The block particle i adds between rows j and columns k,
+//     V_i sum_q w_q sum_{b,d} c_ij(q)_b C_iq[(a, b), (c, d)] c_ik(q)_d,
+// is then G_ij contracted with the moments M_i[(a, b, m), (c, d, l)] = V_i sum_q w_q e_q[m]
+// e_q[l] C_iq[(a, b), (c, d)] and with G_ik: one contraction per pair (j, k) instead of one per
+// point, and one look-up of the block's place in the pattern.
+template <int D, int E>
+struct StiffnessMoments {
+  static constexpr int size = D * D * E;  // index (a * D + b) * E + m
+  using Moments = Eigen::Matrix<double, size, size>;
+  using Coefficients = Eigen::Matrix<double, D * E, 1>;  // G_ik flattened: index d * E + l
+  using Contracted = Eigen::Matrix<double, D, size>;     // G_ij contracted with M_i
 
-// Adds the material stiffness sum_i V_i sum_q w_q H^q_ij^T C_iq H^q_ik to the pattern's blocks K,
-// one point q at a time (one point, at the particle, without a quadrature), and the zero-energy
-// control's constant stiffness.
-template <int D>
+  static Coefficients coefficients(const ReferencePairs<D>& pairs, std::size_t i,
+                                   std::size_t slot) {
+    Coefficients g;
+    const Vec<D> c = coefficient(pairs, i, slot);
+    if constexpr (E == 1) {
+      g = c;
+    } else {
+      const Mat<D> h = curvature_coefficient(pairs, i, slot);
+      for (int d = 0; d < D; ++d) {
+        g[d * E] = c[d];
+        for (int k = 0; k < D; ++k) g[d * E + 1 + k] = h(d, k);
+      }
+    }
+    return g;
+  }
+
+  static Moments moments(const std::vector<MaterialTangent<D>>& C, std::size_t i, double volume,
+                         const EnergyQuadrature<D>* quadrature) {
+    constexpr int points = E == 1 ? 1 : EnergyQuadrature<D>::points;
+    Moments M = Moments::Zero();
+    for (int q = 0; q < points; ++q) {
+      Eigen::Matrix<double, E, 1> e;
+      e[0] = 1.0;
+      if constexpr (E > 1) e.template tail<D>() = quadrature->offset[i][q];
+      const Eigen::Matrix<double, E, E> ee = (volume / points) * e * e.transpose();
+      const MaterialTangent<D>& Cq = C[i * points + q];
+      for (int r = 0; r < D * D; ++r)
+        for (int col = 0; col < D * D; ++col)
+          M.template block<E, E>(r * E, col * E) += Cq(r, col) * ee;
+    }
+    return M;
+  }
+
+  // G_ij^T M_i: P[a, (c, d, l)] = sum_{b, m} G_ij[b, m] M_i[(a, b, m), (c, d, l)].
+  static Contracted contract(const Coefficients& g, const Moments& M) {
+    Contracted P = Contracted::Zero();
+    for (int a = 0; a < D; ++a)
+      for (int bm = 0; bm < D * E; ++bm) P.row(a) += g[bm] * M.row(a * D * E + bm);
+    return P;
+  }
+
+  // The block: K[a, c] = sum_{d, l} P[a, (c, d, l)] G_ik[d, l].
+  static Mat<D> block(const Contracted& P, const Coefficients& g) {
+    Mat<D> b;
+    for (int c = 0; c < D; ++c) b.col(c) = P.template middleCols<D * E>(c * D * E) * g;
+    return b;
+  }
+};
+
+// Adds sum_i (the stiffness of particle i's energy) and the zero-energy control's constant
+// stiffness to the pattern's blocks K. Row j gathers over the particles i whose F depends on u_j
+// (j itself and its neighbours).
+template <int D, int E>
 void add_material_stiffness(const ReferencePairs<D>& pairs, const TangentPattern& pattern,
                             const std::vector<double>& volume,
                             const std::vector<MaterialTangent<D>>& C,
                             const FitResidualControl<D>* control,
                             const EnergyQuadrature<D>* quadrature, std::vector<Block<D>>& K) {
+  using Form = StiffnessMoments<D, E>;
   const NeighbourList& nl = pairs.neighbours;
   const std::size_t n = nl.particle_count();
-  std::vector<std::size_t> slot_offset(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) slot_offset[i + 1] = slot_offset[i] + slots(nl, i);
-  std::vector<Contracted<D>> Q(slot_offset[n]);
-  const int points = quadrature ? EnergyQuadrature<D>::points : 1;
-  const double weight = 1.0 / points;
-  for (int q = 0; q < points; ++q) {
-    // The coefficients of F at point q of particle i's dual cell: c_ik + h_ik d_q.
-    auto coefficient_at = [&](std::size_t i, std::size_t slot) -> Vec<D> {
-      if (!quadrature) return coefficient(pairs, i, slot);
-      return coefficient(pairs, i, slot) +
-             curvature_coefficient(pairs, i, slot) * quadrature->offset[i][q];
-    };
-    // Q_ik = C_i H_ik per slot: Q[(a, b), c] = sum_d C_i[(a, b), (c, d)] c_ik[d].
-    parallel_for_each_index(n, [&](std::size_t i) {
-      const MaterialTangent<D>& Ci = C[i * points + q];
+  std::vector<typename Form::Moments> M(n);
+  parallel_for_each_index(
+      n, [&](std::size_t i) { M[i] = Form::moments(C, i, volume[i], quadrature); });
+  parallel_for_each_index(n, [&](std::size_t j) {
+    auto add_particle = [&](std::size_t i, std::size_t slot_of_j) {
+      const typename Form::Contracted P =
+          Form::contract(Form::coefficients(pairs, i, slot_of_j), M[i]);
       for (std::size_t s = 0; s < slots(nl, i); ++s) {
-        const Vec<D> c = coefficient_at(i, s);
-        Contracted<D>& out = Q[slot_offset[i] + s];
-        for (int col = 0; col < D; ++col) {
-          Eigen::Matrix<double, D * D, 1> sum = Eigen::Matrix<double, D * D, 1>::Zero();
-          for (int d = 0; d < D; ++d) sum += Ci.col(col * D + d) * c[d];
-          out.col(col) = sum;
-        }
+        Block<D> b = Form::block(P, Form::coefficients(pairs, i, s));
+        if (control) b.diagonal().array() += control->stiffness(i, slot_of_j, s);
+        K[find_column(pattern, j, node(pairs, i, s))] += b;
       }
-    });
-    // Row j of K: sum over the particles i whose F depends on u_j (j itself and its neighbours).
-    parallel_for_each_index(n, [&](std::size_t j) {
-      auto add_particle = [&](std::size_t i, std::size_t slot_of_j) {
-        const Vec<D> c_ij = coefficient_at(i, slot_of_j);
-        for (std::size_t s = 0; s < slots(nl, i); ++s) {
-          const Contracted<D>& Qs = Q[slot_offset[i] + s];
-          Block<D> b = Block<D>::Zero();
-          for (int a = 0; a < D; ++a)
-            for (int bb = 0; bb < D; ++bb) b.row(a) += c_ij[bb] * Qs.row(a * D + bb);
-          b *= weight * volume[i];
-          if (control && q == 0) b.diagonal().array() += control->stiffness(i, slot_of_j, s);
-          K[find_column(pattern, j, node(pairs, i, s))] += b;
-        }
-      };
-      add_particle(j, 0);
-      // Neighbour i's slot of j: the reverse pair's place in i's list (slot 0 is i itself).
-      for (std::size_t k = nl.offset[j]; k < nl.offset[j + 1]; ++k)
-        add_particle(nl.index[k], pairs.reverse_pair[k] - nl.offset[nl.index[k]] + 1);
-    });
-  }
+    };
+    add_particle(j, 0);
+    // Neighbour i's slot of j: the reverse pair's place in i's list (slot 0 is i itself).
+    for (std::size_t k = nl.offset[j]; k < nl.offset[j + 1]; ++k)
+      add_particle(nl.index[k], pairs.reverse_pair[k] - nl.offset[nl.index[k]] + 1);
+  });
 }
 
 // Subtracts L_i H_ik from row i for the particles with a force of their own (L_i = df_i/dF_i).
@@ -220,7 +255,10 @@ Eigen::SparseMatrix<double> assemble_tangent(const ReferencePairs<D>& pairs,
                                              const FitResidualControl<D>* control,
                                              const EnergyQuadrature<D>* quadrature) {
   std::vector<Block<D>> K(pattern.column.size(), Block<D>::Zero());
-  add_material_stiffness<D>(pairs, pattern, volume, C, control, quadrature, K);
+  if (quadrature)
+    add_material_stiffness<D, D + 1>(pairs, pattern, volume, C, control, quadrature, K);
+  else
+    add_material_stiffness<D, 1>(pairs, pattern, volume, C, control, quadrature, K);
   add_own_force_stiffness<D>(pairs, pattern, force_tangent_particles, force_tangents, K);
   return lower_symmetric_part<D>(pattern, K, dof, unknowns);
 }

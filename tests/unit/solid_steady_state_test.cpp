@@ -96,11 +96,11 @@ TEST(SolidSteadyState, ReportsItsIterationsAndResidualInTheSummary) {
   // Two increments over the ramp, then one at full load that is already in balance.
   EXPECT_EQ(stats.at("load_increments"), 3.0);
   EXPECT_EQ(stats.at("increment_bisections"), 0.0);
-  // Measured 122 quasi-Newton iterations (61 + 61 + 0) on 3 factorisations: the first increment
-  // factorises at its start and again when the history of 60 fills; the second starts on that
-  // second factorisation, kept from the converged first, and refreshes once (4 factorisations
-  // when each increment assembled its own first tangent). Exact Newton took 27 iterations, each
-  // with a factorisation.
+  // Measured 122-129 quasi-Newton iterations (61 + 61-68 + 0; the count moves by a few with the
+  // tangent's round-off) on 3 factorisations: the first increment factorises at its start and
+  // again when the history of 60 fills; the second starts on that second factorisation, kept from
+  // the converged first, and refreshes once (4 factorisations when each increment assembled its
+  // own first tangent). Exact Newton took 27 iterations, each with a factorisation.
   EXPECT_GE(stats.at("newton_iterations"), 100.0);
   EXPECT_LE(stats.at("newton_iterations"), 150.0);
   EXPECT_EQ(stats.at("tangent_factorisations"), 3.0);
@@ -113,13 +113,16 @@ TEST(SolidSteadyState, ReportsItsIterationsAndResidualInTheSummary) {
 }
 
 TEST(SolidSteadyState, BisectsAnIncrementThatDoesNotConvergeAndStopsWithAClearError) {
-  // The whole load at once takes 74 iterations and each half 61 (measured): with 66 allowed, the
-  // one increment is halved once.
+  // The whole load at once takes 70-71 iterations, the two halves 122-129 (measured; the counts
+  // move by a few with the tangent's round-off): with 66 allowed, the one increment is halved,
+  // and a half that still needs more is halved again. Every bisection adds one increment.
   auto halved = make_simulation(kBeam, {"modules[0].solid.steady_state.load_steps=1",
                                         "modules[0].solid.steady_state.max_iterations=66"});
   const RunSummary summary = halved->run();
-  EXPECT_EQ(summary.modules[0].statistics.at("increment_bisections"), 1.0);
-  EXPECT_EQ(summary.modules[0].statistics.at("load_increments"), 2.0);
+  const double bisections = summary.modules[0].statistics.at("increment_bisections");
+  EXPECT_GE(bisections, 1.0);
+  EXPECT_LE(bisections, 3.0);
+  EXPECT_EQ(summary.modules[0].statistics.at("load_increments"), 1.0 + bisections);
   EXPECT_LT(summary.modules[0].statistics.at("relative_residual"), 1e-8);
   // One iteration to a tolerance that it cannot reach: bisections run out, and the error says
   // where and how far it got.
