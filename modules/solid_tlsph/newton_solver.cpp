@@ -32,6 +32,10 @@ void fix_blas_threads() {
   (void)done;
 }
 
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 double norm_or_infinity(const Eigen::VectorXd& r) {
   const double n = r.norm();
   return std::isfinite(n) ? n : INFINITY;
@@ -85,14 +89,16 @@ NewtonSolver& NewtonSolver::operator=(NewtonSolver&&) noexcept = default;
 // factorised tangent: the pairs (s, y) of the iterations since the last factorisation correct
 // K0^-1 toward the current tangent, so that most iterations cost a residual and two triangular
 // solves instead of an assembly and a factorisation (Matthies & Strang 1979).
-Eigen::VectorXd NewtonSolver::direction(const Eigen::VectorXd& r) const {
+Eigen::VectorXd NewtonSolver::direction(const Eigen::VectorXd& r) {
   Eigen::VectorXd q = r;
   std::vector<double> a(history_.size());
   for (std::size_t k = history_.size(); k-- > 0;) {
     a[k] = history_[k].rho * history_[k].s.dot(q);
     q -= a[k] * history_[k].y;
   }
+  const auto start = std::chrono::steady_clock::now();
   Eigen::VectorXd z = factorisation_->solve(q);
+  triangular_solve_seconds_ += seconds_since(start);
   for (std::size_t k = 0; k < history_.size(); ++k) {
     const double b = history_[k].rho * history_[k].y.dot(z);
     z += (a[k] - b) * history_[k].s;
@@ -112,9 +118,7 @@ bool NewtonSolver::line_search(const Eigen::VectorXd& step, const Residual& resi
   double alpha = 1.0, previous_alpha = 0.0, previous_slope = s0;
   for (int trial_count = 0; trial_count < kLineSearchTrials; ++trial_count) {
     trial_.x = at.x + alpha * step;
-    trial_.scale = residual(trial_.x, trial_.r);
-    ++outcome.residual_evaluations;
-    trial_.norm = norm_or_infinity(trial_.r);
+    evaluate(residual, trial_, outcome);
     if (!std::isfinite(trial_.norm)) {
       alpha *= 0.5;
       continue;
@@ -134,11 +138,19 @@ bool NewtonSolver::line_search(const Eigen::VectorXd& step, const Residual& resi
   return false;
 }
 
+// Fills r, scale and norm of the iterate at its x.
+void NewtonSolver::evaluate(const Residual& residual, Iterate& at, NewtonOutcome& outcome) {
+  const auto start = std::chrono::steady_clock::now();
+  at.scale = residual(at.x, at.r);
+  residual_seconds_ += seconds_since(start);
+  ++outcome.residual_evaluations;
+  at.norm = norm_or_infinity(at.r);
+}
+
 int NewtonSolver::factorise(const Eigen::SparseMatrix<double>& K) {
   const auto start = std::chrono::steady_clock::now();
   const int shifts = factorisation_->factorise(K);
-  factorisation_seconds_ +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  factorisation_seconds_ += seconds_since(start);
   history_.clear();
   factorised_ = shifts >= 0;
   return shifts;
@@ -163,9 +175,7 @@ NewtonOutcome NewtonSolver::solve(Eigen::VectorXd& x, const Residual& residual,
   Iterate at;
   at.x = x;
   at.r.resize(x.size());
-  at.scale = residual(at.x, at.r);
-  ++outcome.residual_evaluations;
-  at.norm = norm_or_infinity(at.r);
+  evaluate(residual, at, outcome);
   auto converged = [&] { return at.norm == 0.0 || at.norm <= settings.tolerance * at.scale; };
   history_.clear();
   bool stale = !kept_;  // no factorisation to start from

@@ -72,7 +72,11 @@ class NewtonSolver {
   NewtonSolver(NewtonSolver&&) noexcept;
   NewtonSolver& operator=(NewtonSolver&&) noexcept;
 
+  // Where a solve's time went, summed over every solve of this solver: the factorisations, the
+  // triangular solves of the directions, and the residual calls (line-search trials included).
   double factorisation_seconds() const { return factorisation_seconds_; }
+  double triangular_solve_seconds() const { return triangular_solve_seconds_; }
+  double residual_seconds() const { return residual_seconds_; }
 
  private:
   struct Factorisation;  // the sparse solvers (newton_solver.cpp), kept out of this header
@@ -85,7 +89,8 @@ class NewtonSolver {
     double rho = 0.0;
   };
 
-  Eigen::VectorXd direction(const Eigen::VectorXd& r) const;
+  Eigen::VectorXd direction(const Eigen::VectorXd& r);
+  void evaluate(const Residual& residual, Iterate& at, NewtonOutcome& outcome);
   bool line_search(const Eigen::VectorXd& step, const Residual& residual, Iterate& at,
                    NewtonOutcome& outcome);
   int factorise(const Eigen::SparseMatrix<double>& K);  // shifted attempts, or -1
@@ -94,7 +99,7 @@ class NewtonSolver {
   std::unique_ptr<Factorisation> factorisation_;
   std::vector<HistoryPair> history_;
   Iterate trial_;
-  double factorisation_seconds_ = 0.0;
+  double factorisation_seconds_ = 0.0, triangular_solve_seconds_ = 0.0, residual_seconds_ = 0.0;
   bool factorised_ = false;  // the last factorisation succeeded
   bool kept_ = false;  // it is from a converged solve (or adopted): the next solve starts on it
 };

@@ -95,8 +95,15 @@ class SolidModule final : public StaticBodyModule<D> {
       info.statistics["tangent_factorisations"] = double(factorisations_);
       info.statistics["shifted_factorisations"] = double(shifted_factorisations_);
       info.statistics["relative_residual"] = steady_residual_;
-      info.statistics["factorisation_seconds"] =
-          equilibrium_ ? equilibrium_->factorisation_seconds() : 0.0;
+      info.statistics["residual_evaluations"] = double(residual_evaluations_);
+      // Where the steady state's time went (this process's solves; not checkpointed).
+      if (equilibrium_) {
+        info.statistics["tangent_assembly_seconds"] = equilibrium_->assembly_seconds();
+        info.statistics["factorisation_seconds"] = equilibrium_->solver().factorisation_seconds();
+        info.statistics["triangular_solve_seconds"] =
+            equilibrium_->solver().triangular_solve_seconds();
+        info.statistics["residual_seconds"] = equilibrium_->solver().residual_seconds();
+      }
     }
     return info;
   }
@@ -324,6 +331,7 @@ class SolidModule final : public StaticBodyModule<D> {
       state.integers["load_increments"] = steady_increments_;
       state.integers["increment_bisections"] = steady_bisections_;
       state.integers["newton_iterations"] = newton_iterations_;
+      state.integers["residual_evaluations"] = residual_evaluations_;
       state.integers["tangent_factorisations"] = factorisations_;
       state.integers["shifted_factorisations"] = shifted_factorisations_;
       state.scalars["relative_residual"] = steady_residual_;
@@ -358,6 +366,7 @@ class SolidModule final : public StaticBodyModule<D> {
       steady_increments_ = read.integer("load_increments");
       steady_bisections_ = read.integer("increment_bisections");
       newton_iterations_ = read.integer("newton_iterations");
+      residual_evaluations_ = read.integer("residual_evaluations");
       factorisations_ = read.integer("tangent_factorisations");
       shifted_factorisations_ = read.integer("shifted_factorisations");
       steady_residual_ = read.scalar("relative_residual");
@@ -507,6 +516,7 @@ class SolidModule final : public StaticBodyModule<D> {
   // mean over its cell's points.
   double strain_energy(std::size_t i, const Mat<D>& frame, const std::vector<Vec<D>>& u) const {
     auto energy = [&](const Mat<D>& F) {
+      if (!material_.anisotropic()) return material_.energy(F, frame);  // no fibre to average
       return over_fibres(i, frame, [&](const Mat<D>& f) { return material_.energy(F, f); });
     };
     if (quadrature_.offset.empty()) return energy(F_[i]);
@@ -1069,6 +1079,7 @@ class SolidModule final : public StaticBodyModule<D> {
                             spec_.steady_state().max_iterations()};
     const NewtonOutcome outcome = equilibrium_->solve(t0, t1, u, static_body_, settings);
     newton_iterations_ += outcome.iterations;
+    residual_evaluations_ += outcome.residual_evaluations;
     factorisations_ += outcome.factorisations;
     shifted_factorisations_ += outcome.shifted_factorisations;
     steady_residual_ = outcome.relative_residual;
@@ -1123,7 +1134,7 @@ class SolidModule final : public StaticBodyModule<D> {
   std::vector<Index> loaded_particles_;  // particles under a follower pressure
   std::vector<long long> loaded_slot_;   // their index in loaded_particles_ (-1: none)
   long long steady_increments_ = 0, steady_bisections_ = 0, newton_iterations_ = 0,
-            factorisations_ = 0, shifted_factorisations_ = 0;
+            residual_evaluations_ = 0, factorisations_ = 0, shifted_factorisations_ = 0;
   double steady_residual_ = 0.0;
   double stiffness_eigenvalue_ = 0.0;
 };

@@ -1,5 +1,7 @@
 #include "solid_tlsph/static_equilibrium.hpp"
 
+#include <chrono>
+
 #include "core/error.hpp"
 
 namespace cosph {
@@ -45,9 +47,13 @@ NewtonOutcome StaticEquilibrium<D>::solve(double t_start, double t, std::vector<
     tangent_point_.force_time = t;
     tangent_point_.tangent_time = first ? t_start : t;
     first = false;
+    const auto start = std::chrono::steady_clock::now();
     body.tangents(tangent_point_.tangent_time, C_, loaded_, L_);
-    return assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_, unknowns_,
-                               body.control, body.quadrature);
+    Eigen::SparseMatrix<double> K = assemble_tangent<D>(
+        pairs_, pattern_, volume_, C_, loaded_, L_, dof_, unknowns_, body.control, body.quadrature);
+    assembly_seconds_ +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return K;
   };
   const NewtonOutcome outcome = solver_.solve(x, residual, tangent, settings);
   scatter(x, u);

@@ -95,7 +95,8 @@ class StaticEquilibrium {
 
   long long unknowns() const { return unknowns_; }
   std::size_t tangent_blocks() const { return pattern_.column.size(); }
-  double factorisation_seconds() const { return solver_.factorisation_seconds(); }
+  const NewtonSolver& solver() const { return solver_; }
+  double assembly_seconds() const { return assembly_seconds_; }  // tangents and their assembly
 
  private:
   void scatter(const Eigen::VectorXd& x, std::vector<Vec<D>>& u) const;
@@ -111,6 +112,7 @@ class StaticEquilibrium {
   std::vector<ForceTangent<D>> L_;
   std::vector<Vec<D>> force_;
   TangentPoint tangent_point_;
+  double assembly_seconds_ = 0.0;
 };
 
 }  // namespace cosph

@@ -106,6 +106,18 @@ TEST(SolidSteadyState, ReportsItsIterationsAndResidualInTheSummary) {
   EXPECT_EQ(stats.at("tangent_factorisations"), 3.0);
   EXPECT_EQ(stats.at("shifted_factorisations"), 0.0);
   EXPECT_LT(stats.at("relative_residual"), 1e-8);
+  // One residual per increment's start and one to four per iteration (the line-search trials).
+  EXPECT_GE(stats.at("residual_evaluations"), stats.at("newton_iterations") + 3.0);
+  EXPECT_LE(stats.at("residual_evaluations"), 4.0 * stats.at("newton_iterations") + 3.0);
+  // Where the time went: every part was spent, and together they fit in the module's advance.
+  double parts = 0.0;
+  for (const char* part : {"tangent_assembly_seconds", "factorisation_seconds",
+                           "triangular_solve_seconds", "residual_seconds"}) {
+    ASSERT_TRUE(stats.count(part)) << part;
+    EXPECT_GT(stats.at(part), 0.0) << part;
+    parts += stats.at(part);
+  }
+  EXPECT_LE(parts, summary.modules[0].advance_seconds);
   EXPECT_EQ(summary.steps, 3u);
   const std::string json = summary.to_json();
   EXPECT_NE(json.find("\"statistics\": {"), std::string::npos) << json;
