@@ -5,10 +5,10 @@
 // measuring anything. A remote module will be the same kind of forwarding object.
 #pragma once
 
-#include <chrono>
 #include <memory>
 #include <utility>
 
+#include "core/scoped_seconds.hpp"
 #include "driver/module.hpp"
 
 namespace cosph {
@@ -52,9 +52,8 @@ class TimedModule final : public Module {
  private:
   template <typename F>
   void timed(const F& f) {
-    const auto start = std::chrono::steady_clock::now();
+    const ScopedSeconds timer(seconds_);
     f();
-    seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
   std::unique_ptr<Module> module_;

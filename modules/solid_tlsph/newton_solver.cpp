@@ -4,8 +4,9 @@
 
 #include <Eigen/CholmodSupport>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+
+#include "core/scoped_seconds.hpp"
 
 namespace cosph {
 
@@ -30,10 +31,6 @@ void fix_blas_threads() {
     return true;
   }();
   (void)done;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 double norm_or_infinity(const Eigen::VectorXd& r) {
@@ -96,9 +93,11 @@ Eigen::VectorXd NewtonSolver::direction(const Eigen::VectorXd& r) {
     a[k] = history_[k].rho * history_[k].s.dot(q);
     q -= a[k] * history_[k].y;
   }
-  const auto start = std::chrono::steady_clock::now();
-  Eigen::VectorXd z = factorisation_->solve(q);
-  triangular_solve_seconds_ += seconds_since(start);
+  Eigen::VectorXd z;
+  {
+    const ScopedSeconds timer(triangular_solve_seconds_);
+    z = factorisation_->solve(q);
+  }
   for (std::size_t k = 0; k < history_.size(); ++k) {
     const double b = history_[k].rho * history_[k].y.dot(z);
     z += (a[k] - b) * history_[k].s;
@@ -140,17 +139,20 @@ bool NewtonSolver::line_search(const Eigen::VectorXd& step, const Residual& resi
 
 // Fills r, scale and norm of the iterate at its x.
 void NewtonSolver::evaluate(const Residual& residual, Iterate& at, NewtonOutcome& outcome) {
-  const auto start = std::chrono::steady_clock::now();
-  at.scale = residual(at.x, at.r);
-  residual_seconds_ += seconds_since(start);
+  {
+    const ScopedSeconds timer(residual_seconds_);
+    at.scale = residual(at.x, at.r);
+  }
   ++outcome.residual_evaluations;
   at.norm = norm_or_infinity(at.r);
 }
 
 int NewtonSolver::factorise(const Eigen::SparseMatrix<double>& K) {
-  const auto start = std::chrono::steady_clock::now();
-  const int shifts = factorisation_->factorise(K);
-  factorisation_seconds_ += seconds_since(start);
+  int shifts;
+  {
+    const ScopedSeconds timer(factorisation_seconds_);
+    shifts = factorisation_->factorise(K);
+  }
   history_.clear();
   factorised_ = shifts >= 0;
   return shifts;

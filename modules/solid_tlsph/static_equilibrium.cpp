@@ -1,8 +1,7 @@
 #include "solid_tlsph/static_equilibrium.hpp"
 
-#include <chrono>
-
 #include "core/error.hpp"
+#include "core/scoped_seconds.hpp"
 
 namespace cosph {
 
@@ -20,6 +19,15 @@ template <int D>
 void StaticEquilibrium<D>::scatter(const Eigen::VectorXd& x, std::vector<Vec<D>>& u) const {
   for (std::size_t k = 0; k < dof_.size(); ++k)
     if (dof_[k] >= 0) u[k / D][static_cast<int>(k % D)] = x[dof_[k]];
+}
+
+// The tangent at the F of the body's last force call, with the loads of tangent_time.
+template <int D>
+Eigen::SparseMatrix<double> StaticEquilibrium<D>::assemble(const Body& body, double tangent_time) {
+  const ScopedSeconds timer(assembly_seconds_);
+  body.tangents(tangent_time, C_, loaded_, L_);
+  return assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_, unknowns_,
+                             body.control, body.quadrature);
 }
 
 template <int D>
@@ -47,13 +55,7 @@ NewtonOutcome StaticEquilibrium<D>::solve(double t_start, double t, std::vector<
     tangent_point_.force_time = t;
     tangent_point_.tangent_time = first ? t_start : t;
     first = false;
-    const auto start = std::chrono::steady_clock::now();
-    body.tangents(tangent_point_.tangent_time, C_, loaded_, L_);
-    Eigen::SparseMatrix<double> K = assemble_tangent<D>(
-        pairs_, pattern_, volume_, C_, loaded_, L_, dof_, unknowns_, body.control, body.quadrature);
-    assembly_seconds_ +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return K;
+    return assemble(body, tangent_point_.tangent_time);
   };
   const NewtonOutcome outcome = solver_.solve(x, residual, tangent, settings);
   scatter(x, u);
@@ -64,9 +66,7 @@ template <int D>
 void StaticEquilibrium<D>::restore_tangent(const TangentPoint& point, const Body& body) {
   force_.resize(point.u.size());
   body.force(point.force_time, point.u, force_);  // F at the point, for the tangent call
-  body.tangents(point.tangent_time, C_, loaded_, L_);
-  if (!solver_.adopt_tangent(assemble_tangent<D>(pairs_, pattern_, volume_, C_, loaded_, L_, dof_,
-                                                 unknowns_, body.control, body.quadrature)))
+  if (!solver_.adopt_tangent(assemble(body, point.tangent_time)))
     throw RuntimeError("the checkpoint's steady-state tangent does not factorise");
   tangent_point_ = point;
 }

@@ -96,10 +96,12 @@ class StaticEquilibrium {
   long long unknowns() const { return unknowns_; }
   std::size_t tangent_blocks() const { return pattern_.column.size(); }
   const NewtonSolver& solver() const { return solver_; }
-  double assembly_seconds() const { return assembly_seconds_; }  // tangents and their assembly
+  // The tangents' evaluation and assembly, a restart's included.
+  double assembly_seconds() const { return assembly_seconds_; }
 
  private:
   void scatter(const Eigen::VectorXd& x, std::vector<Vec<D>>& u) const;
+  Eigen::SparseMatrix<double> assemble(const Body& body, double tangent_time);
 
   const ReferencePairs<D>& pairs_;
   std::vector<double> volume_;
