@@ -63,6 +63,8 @@ class NewtonSolver {
   // Whether the next solve starts on a kept factorisation (no tangent call before its first
   // step).
   bool has_factorisation() const { return kept_; }
+  // The next solve starts on a fresh tangent (a guess far from the last equilibrium).
+  void drop_factorisation() { kept_ = false; }
   // Factorises K as if a converged solve had left it (a restart rebuilds the kept factorisation
   // from the checkpoint). Not counted in any outcome. Returns false where K does not factorise.
   bool adopt_tangent(const Eigen::SparseMatrix<double>& K);

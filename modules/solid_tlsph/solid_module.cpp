@@ -4,15 +4,18 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <sstream>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
+#include "core/scoped_seconds.hpp"
 #include "driver/state_reader.hpp"
 #include "driver/static_body_module.hpp"
 #include "geometry/regions.hpp"
 #include "geometry/surface.hpp"
+#include "io/probes.hpp"
 #include "solid_tlsph/fibre_frames.hpp"
 #include "solid_tlsph/material_model.hpp"
 #include "solid_tlsph/static_equilibrium.hpp"
@@ -48,6 +51,8 @@ class SolidModule final : public StaticBodyModule<D> {
           parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));
     if (spec_.has_steady_state()) check_steady_state_spec();
     if (dual_cell_quadrature()) check_energy_quadrature_spec();
+    if (spec_.has_steady_state() && spec_.steady_state().has_grid_sequence())
+      build_coarse_level(spec, context);
   }
 
   ModuleInfo info() const override {
@@ -77,6 +82,10 @@ class SolidModule final : public StaticBodyModule<D> {
                   short_number(spec_.steady_state().tolerance()));
     else
       f.push_back(spec_.integrator() == "rk4" ? "RK4 integrator" : "position Verlet integrator");
+    if (coarse_)
+      f.push_back(
+          "grid sequencing (" + std::to_string(spec_.steady_state().grid_sequence().levels()) +
+          " coarser level(s), coarsest " + std::to_string(coarsest().X_.size()) + " particles)");
     if (spec_.has_artificial_viscosity()) f.push_back("artificial viscosity");
     if (pair_hourglass()) f.push_back("hourglass control");
     if (fit_residual_hourglass()) f.push_back("hourglass control (fit residual)");
@@ -96,6 +105,11 @@ class SolidModule final : public StaticBodyModule<D> {
       info.statistics["shifted_factorisations"] = double(shifted_factorisations_);
       info.statistics["relative_residual"] = steady_residual_;
       info.statistics["residual_evaluations"] = double(residual_evaluations_);
+      if (coarse_) {
+        info.statistics["smoothing_sweeps"] = double(smoothing_sweeps_);
+        info.statistics["coarse_guesses_rejected"] = double(coarse_guesses_rejected_);
+        info.statistics["coarse_level_newton_iterations"] = double(coarse_->newton_iterations_);
+      }
       // Where the steady state's time went (this process's solves; not checkpointed).
       if (equilibrium_) {
         info.statistics["tangent_assembly_seconds"] = equilibrium_->assembly_seconds();
@@ -103,6 +117,10 @@ class SolidModule final : public StaticBodyModule<D> {
         info.statistics["triangular_solve_seconds"] =
             equilibrium_->solver().triangular_solve_seconds();
         info.statistics["residual_seconds"] = equilibrium_->solver().residual_seconds();
+        if (coarse_) {
+          info.statistics["smoothing_seconds"] = equilibrium_->smoothing_seconds();
+          info.statistics["coarse_level_seconds"] = coarse_seconds_;
+        }
       }
     }
     return info;
@@ -170,6 +188,7 @@ class SolidModule final : public StaticBodyModule<D> {
     auto& u = particles_.vector("displacement");
     apply_constraints(0.0, u, v);
     if (steady()) build_static_equilibrium();
+    if (coarse_) coarse_->initialize();
     if (!spec_.has_time_step() && !steady()) update_stiffness_eigenvalue();
     compute_acceleration(0.0, u, v, particles_.vector("acceleration"));
     prepare_output();
@@ -335,7 +354,9 @@ class SolidModule final : public StaticBodyModule<D> {
       state.integers["tangent_factorisations"] = factorisations_;
       state.integers["shifted_factorisations"] = shifted_factorisations_;
       state.scalars["relative_residual"] = steady_residual_;
-      if (const auto* point = equilibrium_->kept_tangent()) {
+      if (coarse_) save_coarse_level(state);
+      // With a coarse level every step starts on a fresh tangent: none to keep.
+      if (const auto* point = coarse_ ? nullptr : equilibrium_->kept_tangent()) {
         auto& u = state.arrays["steady_tangent_displacement"];
         for (const Vec<D>& ui : point->u) u.insert(u.end(), ui.data(), ui.data() + D);
         state.scalars["steady_tangent_force_time"] = point->force_time;
@@ -370,6 +391,7 @@ class SolidModule final : public StaticBodyModule<D> {
       factorisations_ = read.integer("tangent_factorisations");
       shifted_factorisations_ = read.integer("shifted_factorisations");
       steady_residual_ = read.scalar("relative_residual");
+      if (coarse_) load_coarse_level(state);
       if (const auto* u = read.optional_array("steady_tangent_displacement", D * X_.size()))
         restore_steady_tangent(*u, read.scalar("steady_tangent_force_time"),
                                read.scalar("steady_tangent_load_time"));
@@ -1062,7 +1084,10 @@ class SolidModule final : public StaticBodyModule<D> {
   // One step is a load increment to t + dt, bisected where Newton does not converge.
   void advance_steady(double dt) {
     auto& u = particles_.vector("displacement");
-    solve_increment(time_, time_ + dt, u, 0);
+    if (coarse_)
+      solve_from_coarse_level(time_, time_ + dt, u);
+    else
+      solve_increment(time_, time_ + dt, u, 0);
     static_force(time_ + dt, u, particles_.vector("acceleration"));  // F, P of the solution
     auto& x = particles_.vector("position");
     for (std::size_t i = 0; i < u.size(); ++i) x[i] = X_[i] + u[i];
@@ -1072,17 +1097,117 @@ class SolidModule final : public StaticBodyModule<D> {
               Vec<D>::Zero());
   }
 
-  void solve_increment(double t0, double t1, std::vector<Vec<D>>& u, int depth) {
-    constexpr int kMaxBisections = 6;
+  // ---- Grid sequencing (steady_state.grid_sequence) ----
+
+  // The same module at twice the spacing, one level fewer; the coarsest takes the step in the
+  // grid sequence's load_steps increments and has no sequence of its own.
+  void build_coarse_level(const proto::ModuleSpec& spec, const ModuleContext& context) {
+    const std::string key = key_ + ".steady_state.grid_sequence";
+    if (!spec_.body().has_shape())
+      throw ConfigError(key,
+                        "grid sequencing needs a body generated from a shape (a coarser "
+                        "version of the body's particles is built from it)");
+    const auto& sequence = spec_.steady_state().grid_sequence();
+    coarse_spec_ = std::make_unique<proto::ModuleSpec>(spec);
+    coarse_spec_->set_name(spec.name() + " (grid level " + std::to_string(sequence.levels()) + ")");
+    auto& solid = *coarse_spec_->mutable_solid();
+    solid.mutable_body()->set_spacing(2.0 * spec_.body().spacing());
+    solid.clear_outputs();
+    auto& steady = *solid.mutable_steady_state();
+    if (sequence.levels() > 1)
+      steady.mutable_grid_sequence()->set_levels(sequence.levels() - 1);
+    else
+      steady.clear_grid_sequence();
+    coarse_ = std::make_unique<SolidModule>(*coarse_spec_, context);
+  }
+
+  const SolidModule& coarsest() const { return coarse_ ? coarse_->coarsest() : *this; }
+
+  // The coarse level's displacements interpolated at this body's reference positions.
+  std::vector<Vec<D>> coarse_displacements() {
+    if (!prolongation_) {
+      std::vector<std::string> fields;
+      for (int a = 0; a < D; ++a) fields.push_back(std::string("displacement.") + "xyz"[a]);
+      prolongation_.emplace(
+          X_, fields, std::vector<std::string>{},
+          ProbeOptions{"reference_position", ProbeOptions::Interpolation::linear});
+    }
+    const auto values =
+        prolongation_->sample(coarse_->particles_, "volume", coarse_->kernel_, coarse_->domain_);
+    std::vector<Vec<D>> u(X_.size());
+    for (std::size_t i = 0; i < u.size(); ++i)
+      for (int a = 0; a < D; ++a) {
+        const double v = values[a * u.size() + i];
+        u[i][a] = std::isfinite(v) ? v : 0.0;  // no coarse particle near: no guess there
+      }
+    return u;
+  }
+
+  // The step solved at the coarse level first; this level starts from the coarse increment
+  // added to its last equilibrium, smoothed, on a fresh tangent at the load of t1. A guess that
+  // does not converge is dropped: the step is solved from the last equilibrium instead, in the
+  // coarsest level's increments.
+  void solve_from_coarse_level(double t0, double t1, std::vector<Vec<D>>& u) {
     const std::vector<Vec<D>> start = u;
-    NewtonSettings settings{spec_.steady_state().tolerance(),
-                            spec_.steady_state().max_iterations()};
-    const NewtonOutcome outcome = equilibrium_->solve(t0, t1, u, static_body_, settings);
+    {
+      const ScopedSeconds timer(coarse_seconds_);
+      const std::vector<Vec<D>> before = coarse_displacements();
+      const int increments =
+          coarse_->coarse_ ? 1 : spec_.steady_state().grid_sequence().load_steps();
+      for (int k = 0; k < increments; ++k) coarse_->advance((t1 - t0) / increments);
+      const std::vector<Vec<D>> after = coarse_displacements();
+      for (std::size_t i = 0; i < u.size(); ++i) u[i] += after[i] - before[i];
+    }
+    const SmoothingOutcome smoothing = equilibrium_->smooth(
+        t1, u, static_body_, spec_.steady_state().grid_sequence().smoothing_sweeps());
+    smoothing_sweeps_ += smoothing.sweeps;
+    const NewtonOutcome outcome = equilibrium_->solve(t1, t1, u, static_body_, newton_settings());
+    count(outcome);
+    if (outcome.converged) {
+      ++steady_increments_;
+      return;
+    }
+    // As without a coarse level, in the coarsest level's increments.
+    ++coarse_guesses_rejected_;
+    u = start;
+    const int increments = spec_.steady_state().grid_sequence().load_steps();
+    for (int k = 0; k < increments; ++k)
+      solve_increment(t0 + (t1 - t0) * k / increments, t0 + (t1 - t0) * (k + 1) / increments, u, 0);
+  }
+
+  // The coarse level's state is a child record of this one's.
+  void save_coarse_level(StateRecord& state) const {
+    StateRecord child;
+    child.name = coarse_->name_;
+    coarse_->save(child);
+    state.children.push_back(std::move(child));
+  }
+
+  void load_coarse_level(const StateRecord& state) {
+    for (const auto& child : state.children)
+      if (child.name == coarse_->name_) return coarse_->load(child);
+    throw RuntimeError("module '" + name_ +
+                       "': the checkpoint holds no state of its coarse level '" + coarse_->name_ +
+                       "' (written without grid_sequence?)");
+  }
+
+  NewtonSettings newton_settings() const {
+    return {spec_.steady_state().tolerance(), spec_.steady_state().max_iterations()};
+  }
+
+  void count(const NewtonOutcome& outcome) {
     newton_iterations_ += outcome.iterations;
     residual_evaluations_ += outcome.residual_evaluations;
     factorisations_ += outcome.factorisations;
     shifted_factorisations_ += outcome.shifted_factorisations;
     steady_residual_ = outcome.relative_residual;
+  }
+
+  void solve_increment(double t0, double t1, std::vector<Vec<D>>& u, int depth) {
+    constexpr int kMaxBisections = 6;
+    const std::vector<Vec<D>> start = u;
+    const NewtonOutcome outcome = equilibrium_->solve(t0, t1, u, static_body_, newton_settings());
+    count(outcome);
     if (outcome.converged) {
       ++steady_increments_;
       return;
@@ -1136,6 +1261,13 @@ class SolidModule final : public StaticBodyModule<D> {
   long long steady_increments_ = 0, steady_bisections_ = 0, newton_iterations_ = 0,
             residual_evaluations_ = 0, factorisations_ = 0, shifted_factorisations_ = 0;
   double steady_residual_ = 0.0;
+  // Grid sequencing only: the same body at twice the spacing, its spec (which the twin's base
+  // refers to) and what interpolates its displacements at this body's reference positions.
+  std::unique_ptr<proto::ModuleSpec> coarse_spec_;
+  std::unique_ptr<SolidModule> coarse_;
+  std::optional<PointProbe<D>> prolongation_;
+  long long smoothing_sweeps_ = 0, coarse_guesses_rejected_ = 0;
+  double coarse_seconds_ = 0.0;
   double stiffness_eigenvalue_ = 0.0;
 };
 

@@ -12,6 +12,14 @@ StaticEquilibrium<D>::StaticEquilibrium(const ReferencePairs<D>& pairs,
     : pairs_(pairs), volume_(volume), dof_(prescribed.size(), -1) {
   for (std::size_t k = 0; k < prescribed.size(); ++k)
     if (!prescribed[k]) dof_[k] = unknowns_++;
+  // A particle's free components are consecutive unknowns: one block each.
+  for (std::size_t k = 0; k < dof_.size(); k += D)
+    for (int a = 0; a < D; ++a)
+      if (dof_[k + a] >= 0) {
+        block_start_.push_back(dof_[k + a]);
+        break;
+      }
+  block_start_.push_back(unknowns_);
   pattern_ = build_tangent_pattern<D>(pairs);
 }
 
@@ -31,20 +39,34 @@ Eigen::SparseMatrix<double> StaticEquilibrium<D>::assemble(const Body& body, dou
 }
 
 template <int D>
-NewtonOutcome StaticEquilibrium<D>::solve(double t_start, double t, std::vector<Vec<D>>& u,
-                                          const Body& body, const NewtonSettings& settings) {
-  body.prescribe(t, u);
+Eigen::VectorXd StaticEquilibrium<D>::gather(const std::vector<Vec<D>>& u) const {
   Eigen::VectorXd x(unknowns_);
   for (std::size_t k = 0; k < dof_.size(); ++k)
     if (dof_[k] >= 0) x[dof_[k]] = u[k / D][static_cast<int>(k % D)];
+  return x;
+}
+
+// R(x) on the free components into r, through `trial` (u with x scattered into it); returns the
+// force scale.
+template <int D>
+double StaticEquilibrium<D>::residual(double t, const Eigen::VectorXd& x, Eigen::VectorXd& r,
+                                      std::vector<Vec<D>>& trial, const Body& body) {
+  scatter(x, trial);
+  force_.resize(trial.size());
+  const double scale = body.force(t, trial, force_);
+  for (std::size_t k = 0; k < dof_.size(); ++k)
+    if (dof_[k] >= 0) r[dof_[k]] = force_[k / D][static_cast<int>(k % D)];
+  return scale;
+}
+
+template <int D>
+NewtonOutcome StaticEquilibrium<D>::solve(double t_start, double t, std::vector<Vec<D>>& u,
+                                          const Body& body, const NewtonSettings& settings) {
+  body.prescribe(t, u);
+  Eigen::VectorXd x = gather(u);
   std::vector<Vec<D>> trial = u;
-  force_.resize(u.size());
-  const auto residual = [&](const Eigen::VectorXd& y, Eigen::VectorXd& r) {
-    scatter(y, trial);
-    const double scale = body.force(t, trial, force_);
-    for (std::size_t k = 0; k < dof_.size(); ++k)
-      if (dof_[k] >= 0) r[dof_[k]] = force_[k / D][static_cast<int>(k % D)];
-    return scale;
+  const auto R = [&](const Eigen::VectorXd& y, Eigen::VectorXd& r) {
+    return residual(t, y, r, trial, body);
   };
   // The first tangent a solve assembles itself is at the start (the callback follows the residual
   // of x); on a kept factorisation the first one it assembles is a refresh, at the load of t.
@@ -57,7 +79,25 @@ NewtonOutcome StaticEquilibrium<D>::solve(double t_start, double t, std::vector<
     first = false;
     return assemble(body, tangent_point_.tangent_time);
   };
-  const NewtonOutcome outcome = solver_.solve(x, residual, tangent, settings);
+  const NewtonOutcome outcome = solver_.solve(x, R, tangent, settings);
+  scatter(x, u);
+  return outcome;
+}
+
+template <int D>
+SmoothingOutcome StaticEquilibrium<D>::smooth(double t, std::vector<Vec<D>>& u, const Body& body,
+                                              int sweeps) {
+  const ScopedSeconds timer(smoothing_seconds_);
+  solver_.drop_factorisation();
+  body.prescribe(t, u);
+  Eigen::VectorXd x = gather(u), r(unknowns_);
+  std::vector<Vec<D>> trial = u;
+  const auto R = [&](const Eigen::VectorXd& y, Eigen::VectorXd& out) {
+    return residual(t, y, out, trial, body);
+  };
+  const double scale = R(x, r);
+  const SmoothingOutcome outcome =
+      smooth_block_jacobi(x, r, scale, R, assemble(body, t), block_start_, sweeps);
   scatter(x, u);
   return outcome;
 }

@@ -8,6 +8,7 @@
 #include <functional>
 #include <vector>
 
+#include "solid_tlsph/block_jacobi_smoother.hpp"
 #include "solid_tlsph/newton_solver.hpp"
 #include "solid_tlsph/static_tangent.hpp"
 
@@ -93,20 +94,32 @@ class StaticEquilibrium {
   // RuntimeError where it does not factorise.
   void restore_tangent(const TangentPoint& point, const Body& body);
 
+  // Damped block-Jacobi sweeps on u at the loads of t (block_jacobi_smoother.hpp; a block is a
+  // particle's free components) on the tangent at u: a guess interpolated from a coarser solution
+  // loses its particle-scale error. Drops the kept factorisation, so that the solve that follows
+  // (with t_start = t) starts on a fresh tangent at the smoothed u.
+  SmoothingOutcome smooth(double t, std::vector<Vec<D>>& u, const Body& body, int sweeps);
+
   long long unknowns() const { return unknowns_; }
   std::size_t tangent_blocks() const { return pattern_.column.size(); }
   const NewtonSolver& solver() const { return solver_; }
   // The tangents' evaluation and assembly, a restart's included.
   double assembly_seconds() const { return assembly_seconds_; }
+  // The smoothing sweeps' time (their tangent's assembly included).
+  double smoothing_seconds() const { return smoothing_seconds_; }
 
  private:
   void scatter(const Eigen::VectorXd& x, std::vector<Vec<D>>& u) const;
+  Eigen::VectorXd gather(const std::vector<Vec<D>>& u) const;
+  double residual(double t, const Eigen::VectorXd& x, Eigen::VectorXd& r,
+                  std::vector<Vec<D>>& trial, const Body& body);
   Eigen::SparseMatrix<double> assemble(const Body& body, double tangent_time);
 
   const ReferencePairs<D>& pairs_;
   std::vector<double> volume_;
   std::vector<long long> dof_;
   long long unknowns_ = 0;
+  std::vector<Eigen::Index> block_start_;  // the first unknown of each particle's, and the end
   TangentPattern pattern_;
   NewtonSolver solver_;
   std::vector<MaterialTangent<D>> C_;
@@ -114,7 +127,7 @@ class StaticEquilibrium {
   std::vector<ForceTangent<D>> L_;
   std::vector<Vec<D>> force_;
   TangentPoint tangent_point_;
-  double assembly_seconds_ = 0.0;
+  double assembly_seconds_ = 0.0, smoothing_seconds_ = 0.0;
 };
 
 }  // namespace cosph

@@ -179,14 +179,26 @@ TEST(Determinism, SolidFitResidualHourglassControl) {
 }
 
 // Land's problem 3 as a steady state (quasi-Newton, sparse tangent with the control's stiffness,
-// fibres singular on the axis) in two load increments, the checkpoint between them.
+// fibres singular on the axis) in two load increments, the checkpoint between them: the kept
+// factorisation of the first increment is where the second starts.
 TEST(Determinism, SteadyActiveVentricle3D) {
+  check_determinism({example("solid_land_ventricle_active_static.yaml"),
+                     {"modules[0].solid.body.spacing=0.002",
+                      "modules[0].solid.steady_state={load_steps: 2}", "output.vtp=false"},
+                     1.0,
+                     2},
+                    "solid_steady_ventricle");
+}
+
+// The example's grid-sequenced steady state in two steps: the coarse level's state is a child of
+// the checkpoint, the prolongation and the smoothing sweeps are gathers.
+TEST(Determinism, GridSequencedActiveVentricle3D) {
   check_determinism({example("solid_land_ventricle_active_static.yaml"),
                      {"modules[0].solid.body.spacing=0.002",
                       "modules[0].solid.steady_state.load_steps=2", "output.vtp=false"},
                      1.0,
                      2},
-                    "solid_steady_ventricle");
+                    "solid_grid_sequenced_ventricle");
 }
 
 // Holzapfel-Ogden myocardium with fibres, prescribed active tension and damping, in 3D.
