@@ -108,6 +108,7 @@ class SolidModule final : public StaticBodyModule<D> {
       if (coarse_) {
         info.statistics["smoothing_sweeps"] = double(smoothing_sweeps_);
         info.statistics["coarse_guesses_rejected"] = double(coarse_guesses_rejected_);
+        info.statistics["coarse_level_failed"] = coarse_failed_ ? 1.0 : 0.0;
         info.statistics["coarse_level_newton_iterations"] = double(coarse_->newton_iterations_);
       }
       // Where the steady state's time went (this process's solves; not checkpointed).
@@ -354,7 +355,12 @@ class SolidModule final : public StaticBodyModule<D> {
       state.integers["tangent_factorisations"] = factorisations_;
       state.integers["shifted_factorisations"] = shifted_factorisations_;
       state.scalars["relative_residual"] = steady_residual_;
-      if (coarse_) save_coarse_level(state);
+      if (coarse_) {
+        state.integers["smoothing_sweeps"] = smoothing_sweeps_;
+        state.integers["coarse_guesses_rejected"] = coarse_guesses_rejected_;
+        state.integers["coarse_level_failed"] = coarse_failed_ ? 1 : 0;
+        save_coarse_level(state);
+      }
       // With a coarse level every step starts on a fresh tangent: none to keep.
       if (const auto* point = coarse_ ? nullptr : equilibrium_->kept_tangent()) {
         auto& u = state.arrays["steady_tangent_displacement"];
@@ -391,7 +397,12 @@ class SolidModule final : public StaticBodyModule<D> {
       factorisations_ = read.integer("tangent_factorisations");
       shifted_factorisations_ = read.integer("shifted_factorisations");
       steady_residual_ = read.scalar("relative_residual");
-      if (coarse_) load_coarse_level(state);
+      if (coarse_) {
+        smoothing_sweeps_ = read.integer("smoothing_sweeps");
+        coarse_guesses_rejected_ = read.integer("coarse_guesses_rejected");
+        coarse_failed_ = read.integer("coarse_level_failed") != 0;
+        load_coarse_level(state);
+      }
       if (const auto* u = read.optional_array("steady_tangent_displacement", D * X_.size()))
         restore_steady_tangent(*u, read.scalar("steady_tangent_force_time"),
                                read.scalar("steady_tangent_load_time"));
@@ -1108,9 +1119,9 @@ class SolidModule final : public StaticBodyModule<D> {
                         "grid sequencing needs a body generated from a shape (a coarser "
                         "version of the body's particles is built from it)");
     const auto& sequence = spec_.steady_state().grid_sequence();
-    coarse_spec_ = std::make_unique<proto::ModuleSpec>(spec);
-    coarse_spec_->set_name(spec.name() + " (grid level " + std::to_string(sequence.levels()) + ")");
-    auto& solid = *coarse_spec_->mutable_solid();
+    proto::ModuleSpec coarse = spec;
+    coarse.set_name(spec.name() + " (grid level " + std::to_string(sequence.levels()) + ")");
+    auto& solid = *coarse.mutable_solid();
     solid.mutable_body()->set_spacing(2.0 * spec_.body().spacing());
     solid.clear_outputs();
     auto& steady = *solid.mutable_steady_state();
@@ -1118,7 +1129,7 @@ class SolidModule final : public StaticBodyModule<D> {
       steady.mutable_grid_sequence()->set_levels(sequence.levels() - 1);
     else
       steady.clear_grid_sequence();
-    coarse_ = std::make_unique<SolidModule>(*coarse_spec_, context);
+    coarse_ = std::make_unique<SolidModule>(coarse, context);
   }
 
   const SolidModule& coarsest() const { return coarse_ ? coarse_->coarsest() : *this; }
@@ -1143,13 +1154,25 @@ class SolidModule final : public StaticBodyModule<D> {
     return u;
   }
 
-  // The step solved at the coarse level first; this level starts from the coarse increment
-  // added to its last equilibrium, smoothed, on a fresh tangent at the load of t1. A guess that
-  // does not converge is dropped: the step is solved from the last equilibrium instead, in the
-  // coarsest level's increments.
+  // The step from the coarse level's guess (guess_from_coarse_level); where there is none that
+  // converges, from the last equilibrium in the coarsest level's increments, as without a coarse
+  // level.
   void solve_from_coarse_level(double t0, double t1, std::vector<Vec<D>>& u) {
+    if (!coarse_failed_ && guess_from_coarse_level(t0, t1, u)) return;
+    ++coarse_guesses_rejected_;
+    const int increments = spec_.steady_state().grid_sequence().load_steps();
+    for (int k = 0; k < increments; ++k)
+      solve_increment(t0 + (t1 - t0) * k / increments, t0 + (t1 - t0) * (k + 1) / increments, u, 0);
+  }
+
+  // The step solved at the coarse level first; this level starts from the coarse increment
+  // added to its last equilibrium, smoothed, on a fresh tangent at the load of t1. Returns false
+  // with u unchanged where the guess does not converge, or where the coarse level itself does not
+  // (too coarse to carry the load: Land's ventricle at 2 mm with the energy at the nodes, in three
+  // increments); a failed coarse level is not asked again.
+  bool guess_from_coarse_level(double t0, double t1, std::vector<Vec<D>>& u) {
     const std::vector<Vec<D>> start = u;
-    {
+    try {
       const ScopedSeconds timer(coarse_seconds_);
       const std::vector<Vec<D>> before = coarse_displacements();
       const int increments =
@@ -1157,6 +1180,9 @@ class SolidModule final : public StaticBodyModule<D> {
       for (int k = 0; k < increments; ++k) coarse_->advance((t1 - t0) / increments);
       const std::vector<Vec<D>> after = coarse_displacements();
       for (std::size_t i = 0; i < u.size(); ++i) u[i] += after[i] - before[i];
+    } catch (const RuntimeError&) {
+      coarse_failed_ = true;
+      return false;
     }
     const SmoothingOutcome smoothing = equilibrium_->smooth(
         t1, u, static_body_, spec_.steady_state().grid_sequence().smoothing_sweeps());
@@ -1165,14 +1191,10 @@ class SolidModule final : public StaticBodyModule<D> {
     count(outcome);
     if (outcome.converged) {
       ++steady_increments_;
-      return;
+      return true;
     }
-    // As without a coarse level, in the coarsest level's increments.
-    ++coarse_guesses_rejected_;
     u = start;
-    const int increments = spec_.steady_state().grid_sequence().load_steps();
-    for (int k = 0; k < increments; ++k)
-      solve_increment(t0 + (t1 - t0) * k / increments, t0 + (t1 - t0) * (k + 1) / increments, u, 0);
+    return false;
   }
 
   // The coarse level's state is a child record of this one's.
@@ -1261,12 +1283,12 @@ class SolidModule final : public StaticBodyModule<D> {
   long long steady_increments_ = 0, steady_bisections_ = 0, newton_iterations_ = 0,
             residual_evaluations_ = 0, factorisations_ = 0, shifted_factorisations_ = 0;
   double steady_residual_ = 0.0;
-  // Grid sequencing only: the same body at twice the spacing, its spec (which the twin's base
-  // refers to) and what interpolates its displacements at this body's reference positions.
-  std::unique_ptr<proto::ModuleSpec> coarse_spec_;
+  // Grid sequencing only: the same body at twice the spacing, and what interpolates its
+  // displacements at this body's reference positions.
   std::unique_ptr<SolidModule> coarse_;
   std::optional<PointProbe<D>> prolongation_;
   long long smoothing_sweeps_ = 0, coarse_guesses_rejected_ = 0;
+  bool coarse_failed_ = false;  // the coarse level did not converge: no more guesses
   double coarse_seconds_ = 0.0;
   double stiffness_eigenvalue_ = 0.0;
 };
