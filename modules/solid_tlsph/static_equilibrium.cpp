@@ -89,6 +89,7 @@ SmoothingOutcome StaticEquilibrium<D>::smooth(double t, std::vector<Vec<D>>& u, 
                                               int sweeps) {
   const ScopedSeconds timer(smoothing_seconds_);
   solver_.drop_factorisation();
+  if (sweeps <= 0) return {};  // no tangent to assemble
   body.prescribe(t, u);
   Eigen::VectorXd x = gather(u), r(unknowns_);
   std::vector<Vec<D>> trial = u;
