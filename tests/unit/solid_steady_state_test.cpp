@@ -209,14 +209,16 @@ TEST(SolidSteadyState, GridSequencingReachesTheSameStateInFewerIterations) {
             << stats.at("coarse_level_newton_iterations") << " coarse ones, against "
             << plain_stats.at("newton_iterations") << " on "
             << plain_stats.at("tangent_factorisations") << "\n";
-  EXPECT_LT(difference, 1e-6);  // both solved to 1e-8 relative residual
+  // Measured 1.49e-8 (both solved to 1e-8 relative residual; the solution does not depend on the
+  // thread count or the machine).
+  EXPECT_LT(difference, 2.2e-8);
   // Measured 64 iterations on 2 factorisations, the first shifted (the plain solve: 219 on 3):
   // at 4 mm (two layers through the wall) the coarse level is a poor guess, whose smoothed
   // tangent is still indefinite near the apex; at 1.2 mm for 0.6 mm it is 7 iterations on 1.
   EXPECT_LT(stats.at("tangent_factorisations"), plain_stats.at("tangent_factorisations"));
   EXPECT_EQ(stats.at("coarse_guesses_rejected"), 0.0);
   EXPECT_EQ(stats.at("smoothing_sweeps"), 40.0);
-  EXPECT_LT(stats.at("newton_iterations"), 0.5 * plain_stats.at("newton_iterations"));
+  EXPECT_LT(stats.at("newton_iterations"), 0.44 * plain_stats.at("newton_iterations"));  // 0.29
   EXPECT_GT(stats.at("coarse_level_newton_iterations"), 0.0);
   EXPECT_EQ(stats.at("load_increments"), 1.0);
   for (const char* part : {"smoothing_seconds", "coarse_level_seconds"}) {
@@ -244,7 +246,10 @@ TEST(SolidSteadyState, AGridSequencedGuessThatDoesNotConvergeFallsBackToIncremen
   const auto& stats = summary.modules[0].statistics;
   EXPECT_EQ(stats.at("coarse_guesses_rejected"), 1.0);
   EXPECT_GE(stats.at("load_increments"), 3.0);
-  EXPECT_LT(relative_difference(particles_of<3>(*capped).vector("displacement"), reference), 1e-6);
+  const double difference =
+      relative_difference(particles_of<3>(*capped).vector("displacement"), reference);
+  std::cout << "fallback against four increments: max |du| / max |u| = " << difference << "\n";
+  EXPECT_LT(difference, 3e-9);  // measured 2.0e-9
 }
 
 TEST(SolidSteadyState, GridSequencingWithoutSmoothingStillConverges) {
