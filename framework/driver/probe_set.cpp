@@ -150,8 +150,14 @@ std::unique_ptr<ProbeSet::Probe> make_sensor(const proto::WallSensor& spec, cons
     throw ConfigError(path + ".sensor", e.what());
   }
   // The setup check fills the entry's cache: a static wall's coverage is computed this once.
-  const auto& coverage =
-      entry->cache.of(entry->sensor, particles, body->kernel.support_radius(), body->domain);
+  const typename WallSensor<D>::Coverage* checked = nullptr;
+  try {
+    checked =
+        &entry->cache.of(entry->sensor, particles, body->kernel.support_radius(), body->domain);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(path + ".sensor", e.what());
+  }
+  const auto& coverage = *checked;
   for (std::size_t k = 0; k < coverage.weights.size(); ++k)
     if (coverage.weights[k].empty())
       throw ConfigError(path + ".sensor.at[" + std::to_string(k) + "]",

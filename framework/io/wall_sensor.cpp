@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "core/parallel.hpp"
@@ -104,12 +105,16 @@ void WallSensor<D>::near_face(const ParticleSet<D>& wall, double depth, const Do
 // this face's normal acts on the face's end, so each such particle passes its force to the nearest
 // particle behind the face (ties: the first in the wall's order; none beyond the depth, the
 // kernel's support). Without this, a sensor at the foot of a wall of water at rest read 23% low.
+//
+// Two particles near the face may be neighbours across a periodic seam, their offsets from the
+// face's centre on either side of it: their separation is the minimum image of the offsets'
+// difference.
 template <int D>
 std::vector<std::size_t> WallSensor<D>::receivers(const std::vector<Near>& behind,
-                                                  const std::vector<Near>& front,
-                                                  double depth) const {
+                                                  const std::vector<Near>& front, double depth,
+                                                  const Domain<D>& domain) const {
   const auto overlaps = [&](const Near& p, const Near& q) {
-    const Vec<D> d = p.r - q.r;
+    const Vec<D> d = domain.displacement(p.r, q.r);
     const double reach = 0.5 * (p.a + q.a) * (1.0 - 1e-9);
     for (const Vec<D>& t : tangents_)
       if (std::abs(d.dot(t)) >= reach) return false;
@@ -127,7 +132,7 @@ std::vector<std::size_t> WallSensor<D>::receivers(const std::vector<Near>& behin
     }
     double best = depth;
     for (std::size_t q = 0; q < behind.size(); ++q) {
-      const double d = (behind[q].r - behind[k].r).norm();
+      const double d = domain.displacement(behind[q].r, behind[k].r).norm();
       if (!corner[q] && d < best * (1.0 - 1e-12)) best = d, receiver[k] = q;
     }
   }
@@ -140,7 +145,7 @@ void WallSensor<D>::for_each_covered(const ParticleSet<D>& wall, double depth,
                                      const Domain<D>& domain, std::size_t s, const F& f) const {
   std::vector<Near> behind, front;
   near_face(wall, depth, domain, s, behind, front);
-  const std::vector<std::size_t> receiver = receivers(behind, front, depth);
+  const std::vector<std::size_t> receiver = receivers(behind, front, depth, domain);
   // Each face particle's corner particles, listed once (not a search per face particle).
   std::vector<std::vector<std::size_t>> corners(behind.size());
   for (std::size_t c = 0; c < behind.size(); ++c)
@@ -156,9 +161,31 @@ void WallSensor<D>::for_each_covered(const ParticleSet<D>& wall, double depth,
   }
 }
 
+// A column counts at the minimum image of its offset from the face's centre (near_face). On a
+// periodic axis shorter than the face plus one particle's share (2 radius + sqrt(D - 1) side, the
+// share's extent along any axis of the plane), two images of one column could both lie under the
+// face, and one of them would not count.
+template <int D>
+void WallSensor<D>::require_period(const ParticleSet<D>& wall, const Domain<D>& domain) const {
+  if (!domain.any_periodic()) return;
+  double side = 0.0;
+  for (double v : wall.scalar("volume")) side = std::max(side, std::pow(v, 1.0 / D));
+  const double span = 2.0 * radius_ + std::sqrt(double(D - 1)) * side;
+  for (int a = 0; a < D; ++a)
+    if (domain.periodic[a] && domain.length(a) < span)
+      throw std::invalid_argument(
+          "wall sensor: the periodic axis " + std::to_string(a) + " is " +
+          std::to_string(domain.length(a)) +
+          " long, shorter than the face and one wall particle's " + "share (" +
+          std::to_string(span) +
+          "): a column's two periodic images would both lie under the face; narrow the face or "
+          "lengthen the period");
+}
+
 template <int D>
 typename WallSensor<D>::Coverage WallSensor<D>::coverage(const ParticleSet<D>& wall, double depth,
                                                          const Domain<D>& domain) const {
+  require_period(wall, domain);
   Coverage c;
   c.weights.resize(centres_.size());
   parallel_for_each_index(centres_.size(), [&](std::size_t s) {

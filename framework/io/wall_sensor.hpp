@@ -49,7 +49,10 @@ class WallSensor {
   };
   // From the wall particles' "position" and "volume". `depth` bounds how far behind the face a
   // particle still counts (the fluid's kernel support: deeper particles get no force, and a far
-  // wall must not count). Offsets are minimum images on the domain's periodic axes.
+  // wall must not count). Offsets, and the separations of the particles near a face, are minimum
+  // images on the domain's periodic axes. Throws std::invalid_argument where a periodic axis is
+  // shorter than the face's diameter plus one particle's share: there two images of one column
+  // could both lie under the face, and a minimum image would count one of them only.
   Coverage coverage(const ParticleSet<D>& wall, double depth, const Domain<D>& domain = {}) const;
   // The pressures, one per sensor (NaN where no particle covers it), from the force on each wall
   // particle.
@@ -78,7 +81,10 @@ class WallSensor {
   // for a face particle, the nearest face particle for a corner particle (wall_sensor.cpp), or
   // behind.size() for none.
   std::vector<std::size_t> receivers(const std::vector<Near>& behind,
-                                     const std::vector<Near>& front, double depth) const;
+                                     const std::vector<Near>& front, double depth,
+                                     const Domain<D>& domain) const;
+  // Throws std::invalid_argument for a periodic axis shorter than the face and one share.
+  void require_period(const ParticleSet<D>& wall, const Domain<D>& domain) const;
   // Calls f(w, covered area, share area) for every wall particle w behind sensor s's face, and
   // for each corner particle with its receiver's area and share.
   template <typename F>

@@ -7,9 +7,11 @@
 #include <cmath>
 #include <functional>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "core/particles.hpp"
+#include "neighbour/domain.hpp"
 
 namespace cosph {
 namespace {
@@ -114,6 +116,66 @@ TEST(WallSensor, SensorOffTheWallReadsNaNAndBadInputThrows) {
                              .sample(wall.particles, wall.force, 0.35)[0]));
   EXPECT_THROW(WallSensor<2>({Vec<2>(0.0, 0.0)}, Vec<2>::Zero(), 0.1), std::invalid_argument);
   EXPECT_THROW(WallSensor<2>({Vec<2>(0.0, 0.0)}, Vec<2>::Unit(1), 0.0), std::invalid_argument);
+}
+
+// The wall periodic along x (period 2, its columns continuing across the seam at x = +-1), with
+// the pressure 1 + x of each column: a face of 0.3 centred at x = 0.97 covers 0.08 of the column
+// at 0.85 (pressure 1.85), the column at 0.95 (1.95) and, across the seam, the column at -0.95
+// (0.05) and 0.02 of the one at -0.85 (0.15): (0.148 + 0.195 + 0.005 + 0.003) / 0.3 = 1.17.
+// Without the period the face's part past the seam reads nothing: 0.343 / 0.3 = 1.143.
+Domain<2> periodic_along_x() {
+  Domain<2> domain;
+  domain.lower = Vec<2>(-1.0, -3.0);
+  domain.upper = Vec<2>(1.0, 3.0);
+  domain.periodic = {true, false};
+  return domain;
+}
+
+TEST(WallSensor, AFaceAcrossAPeriodicSeamReadsTheColumnsOnBothSides) {
+  const Wall<2> wall([](const Vec<2>& x) { return 1.0 + x[0]; });
+  const WallSensor<2> sensor({Vec<2>(0.97, 0.0)}, Vec<2>::Unit(1), 0.3);
+  EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.35, periodic_along_x())[0], 1.17, 1e-12);
+  EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.35)[0], 0.343 / 0.3, 1e-12);
+}
+
+// A face with one particle's share fits in the period 2 up to a diameter of 1.9; past it two
+// images of a column could both lie under the face, and the sensor is refused, not read short.
+TEST(WallSensor, APeriodShorterThanTheFaceAndOneShareIsRefused) {
+  const Wall<2> wall([](const Vec<2>&) { return 1.0; });
+  const Domain<2> domain = periodic_along_x();
+  const auto read = [&](double diameter) {
+    return WallSensor<2>({Vec<2>(0.0, 0.0)}, Vec<2>::Unit(1), diameter)
+        .sample(wall.particles, wall.force, 0.35, domain)[0];
+  };
+  EXPECT_NEAR(read(1.9), 1.0, 1e-12);
+  EXPECT_THROW(read(1.95), std::invalid_argument);
+  try {
+    read(1.95);
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("periodic axis 0"), std::string::npos) << e.what();
+  }
+}
+
+// The corner's particles find their receivers across a periodic seam. A wall two columns wide
+// (x in [0.8, 1]) stands on the periodic floor; the face (x in [-0.95, 0.95], over part of that
+// wall only to put the corner on the far side of the centre from the face's other end) takes the
+// floor's uniform pressure 1. The corner column at 0.95 is 0.1 from the face's end column at
+// -0.95 across the seam and 0.2 from the column at 0.75: it passes its force to the end column,
+// whose half is covered, and the face reads 1.9 / 1.9 = 1. Measured by the offsets' plain
+// difference it would pass it to 0.75, covered whole: 1.95 / 1.9 = 1.026.
+TEST(WallSensor, ACornersParticlesFindTheirReceiverAcrossAPeriodicSeam) {
+  Wall<2> wall([](const Vec<2>&) { return 1.0; });
+  auto& x = wall.particles.vector("position");
+  auto& volume = wall.particles.scalar("volume");
+  for (double column : {0.85, 0.95})
+    for (int layer = 0; layer < kLayers; ++layer) {
+      x.emplace_back(column, (layer + 0.5) * kA);
+      volume.push_back(kA * kA);
+      wall.force.push_back(Vec<2>::Zero());
+    }
+  wall.particles.resize(x.size());
+  const WallSensor<2> sensor({Vec<2>(0.0, 0.0)}, Vec<2>::Unit(1), 1.9);
+  EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.35, periodic_along_x())[0], 1.0, 1e-12);
 }
 
 // A moving wall: the cached coverage follows it. The wall with a linear pressure 1 + x slides by
