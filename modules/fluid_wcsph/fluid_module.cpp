@@ -81,8 +81,9 @@ class FluidModule final : public Module {
     if (spec_.viscosity() > 0.0) f.push_back("viscosity");
     if (spec_.gravity_size() > 0) f.push_back("gravity");
     if (spec_.transport_velocity())
-      f.push_back("transport velocity (" + std::to_string(spec_.transport_velocity_sweeps()) +
-                  " sweeps)");
+      f.push_back(
+          "transport velocity (" + std::to_string(spec_.transport_velocity_sweeps()) + " sweeps" +
+          (spec_.transport_velocity_free_surface() > 0.0 ? ", free surface left" : "") + ")");
     if (spec_.walls_size() > 0) f.push_back("walls (one-sided Riemann)");
     if (spec_.pressure_extension() == "clamped") f.push_back("pressure extension clamped at zero");
     for (const auto& o : open_.features()) f.push_back(o);
@@ -835,51 +836,33 @@ class FluidModule final : public Module {
     });
   }
 
-  // Shifts particles away from crowded neighbourhoods (confined flows): the transport-velocity
-  // correction (seed 003 eq. 11) as a position shift -0.4 h^2 sum_j V_j grad W_ij, a gradient
-  // descent on the number density. A single shift larger than this is unstable (the checkerboard
-  // mode overshoots), so the scene's number of sweeps sets how fast the lattice is regularised.
-  // The neighbour list of the step stays valid: each sweep moves a particle by a small fraction
-  // of h.
+  // Shifts particles away from crowded neighbourhoods: the transport-velocity correction (seed
+  // 003 eq. 11) as a position shift -0.4 h^2 sum_j V_j grad W_ij, a gradient descent on the number
+  // density. A single shift larger than this is unstable (the checkerboard mode overshoots), so
+  // the scene's number of sweeps sets how fast the lattice is regularised. The neighbour list of
+  // the step stays valid: each sweep moves a particle by a small fraction of h. In a free-surface
+  // flow (transport_velocity_free_surface > 0) the particles whose number density at the step's
+  // configuration is below that fraction of a full neighbourhood's keep their place over the step's
+  // sweeps: at the surface the shift points out of the water.
   void correct_transport_velocity() {
     auto& x = fluid_.vector("position");
-    const auto& volume = fluid_.scalar("volume");
     const double h = kernel_.smoothing_length();
     shift_.resize(x.size());
     const auto sets = boundaries();
     const auto views = boundary_views(sets);
     const auto truncated = open_.truncation(fluid_);
+    const double surface = spec_.transport_velocity_free_surface() * reference_number_density_;
+    held_.assign(x.size(), 0);
     for (int sweep = 0; sweep < spec_.transport_velocity_sweeps(); ++sweep) {
       // The first sweep finds the particles where the lists were built: sum_j V_j grad W_ij =
       // sum_j V_j (-dW/dr) e_ij from the pair geometry.
       const bool at_build = sweep == 0;
       parallel_for_each_index(x.size(), [&](std::size_t i) {
-        Vec<D> sum = Vec<D>::Zero();
-        for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
-          const Index j = inner_.index[k];
-          if (at_build) {
-            sum += (volume[j] * inner_geometry_.gradient[k]) * inner_geometry_.direction[k];
-            continue;
-          }
-          const Vec<D> d = domain_.displacement(x[i], x[j]);
-          const double r = d.norm();
-          if (r > 0.0) sum += volume[j] * kernel_.derivative(r) / r * d;
-        }
-        for (std::size_t s = 0; s < sets.size(); ++s) {
-          const auto& list = sets[s]->list;
-          const auto& g = sets[s]->geometry;
-          for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k) {
-            const Index w = list.index[k];
-            if (at_build) {
-              sum += (views[s].V[w] * g.gradient[k]) * g.direction[k];
-              continue;
-            }
-            const Vec<D> d = domain_.displacement(x[i], views[s].x[w]);
-            const double r = d.norm();
-            if (r > 0.0) sum += views[s].V[w] * kernel_.derivative(r) / r * d;
-          }
-        }
-        shift_[i] = truncated(i) ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
+        if (held_[i]) return;
+        const Vec<D> sum = at_build ? number_density_gradient_at_build(i, sets, views, surface)
+                                    : number_density_gradient(i, sets, views);
+        held_[i] = held_[i] || truncated(i);
+        shift_[i] = held_[i] ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
       });
       parallel_stream(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift_[i]); });
     }
@@ -916,6 +899,56 @@ class FluidModule final : public Module {
   }
 
   Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
+
+  // sum_j V_j grad W_ij over the fluid and boundary neighbours of i, from the step's pair
+  // geometry; with a free-surface fraction, marks i as held (held_) where its number density
+  // sum_j V_j W_ij (the self term included) is below `surface`.
+  Vec<D> number_density_gradient_at_build(std::size_t i, const std::vector<BoundarySet<D>*>& sets,
+                                          const std::vector<BoundaryView>& views, double surface) {
+    const auto& volume = fluid_.scalar("volume");
+    Vec<D> sum = Vec<D>::Zero();
+    double density = volume[i] * kernel_.value(0.0);
+    const bool count = surface > 0.0;
+    for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
+      const double V = volume[inner_.index[k]];
+      sum += (V * inner_geometry_.gradient[k]) * inner_geometry_.direction[k];
+      if (count) density += V * kernel_.value(inner_geometry_.distance[k]);
+    }
+    for (std::size_t s = 0; s < sets.size(); ++s) {
+      const auto& list = sets[s]->list;
+      const auto& g = sets[s]->geometry;
+      for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k) {
+        const double V = views[s].V[list.index[k]];
+        sum += (V * g.gradient[k]) * g.direction[k];
+        if (count) density += V * kernel_.value(g.distance[k]);
+      }
+    }
+    held_[i] = count && density < surface;
+    return sum;
+  }
+
+  // sum_j V_j grad W_ij at the particles' present positions (the sweeps after the first).
+  Vec<D> number_density_gradient(std::size_t i, const std::vector<BoundarySet<D>*>& sets,
+                                 const std::vector<BoundaryView>& views) const {
+    const auto& x = fluid_.vector("position");
+    const auto& volume = fluid_.scalar("volume");
+    Vec<D> sum = Vec<D>::Zero();
+    for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
+      const Vec<D> d = domain_.displacement(x[i], x[inner_.index[k]]);
+      const double r = d.norm();
+      if (r > 0.0) sum += volume[inner_.index[k]] * kernel_.derivative(r) / r * d;
+    }
+    for (std::size_t s = 0; s < sets.size(); ++s) {
+      const auto& list = sets[s]->list;
+      for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k) {
+        const Index w = list.index[k];
+        const Vec<D> d = domain_.displacement(x[i], views[s].x[w]);
+        const double r = d.norm();
+        if (r > 0.0) sum += views[s].V[w] * kernel_.derivative(r) / r * d;
+      }
+    }
+    return sum;
+  }
 
   // Calls f(e_iw, -dW/dr, V_w, one-sided state of w, set, pair) for every boundary neighbour w of
   // fluid particle i (at x, with pressure p, density rho, velocity v), with the pair geometry of
@@ -1048,6 +1081,7 @@ class FluidModule final : public Module {
   NeighbourList inner_;
   PairGeometry<D> inner_geometry_;
   std::vector<Vec<D>> dv_, shift_;
+  std::vector<char> held_;       // particles the transport-velocity shift leaves this step
   std::vector<Vec<D>> viscous_;  // the sub-cycled viscous acceleration
   double contact_density_ = std::numeric_limits<double>::infinity();  // see contact_viscous_dt
   std::vector<double> viscous_volume_;  // m / rho per particle, for the viscous force

@@ -4,6 +4,7 @@
 // invariance, the equivalence principle, restart) and bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "../support/probe_csv.hpp"
 #include "../support/simulation_setup.hpp"
 #include "core/error.hpp"
+#include "driver/health_monitor.hpp"
 #include "driver/simulation.hpp"
 #include "fluid_wcsph/riemann.hpp"
 #include "module_catalogue.hpp"
@@ -275,6 +277,49 @@ TEST(Fluid, HydrostaticTankHoldsRhoGHAndStaysStill) {
   std::cout << "mid-depth pressure standard deviation " << std::sqrt(square / n) << " Pa\n";
   EXPECT_LT(std::sqrt(square / n), 1.5 * 174.0);
   EXPECT_LT(kinetic, 1e-3 * potential);
+}
+
+// The transport-velocity shift in a free-surface flow: the tank at rest with one sweep per step.
+// Shifting every particle (free_surface 0) pushes the surface's particles out of the water, and
+// the run stops with one outside the domain before t = 1 (at t = 0.73). Leaving the particles
+// whose number density is under 0.95 of a full neighbourhood's, the water stays in its tank; the
+// layers under the surface are shifted up into it, which raises the level at x = 0.5 by 0.0075
+// over t = 0.5-2 (0.15 of a spacing: the unshifted tank's 1.0082 against 1.0158), and the
+// mid-depth pressure reads +7.6% (5,278 Pa against 4,905; +2.6% unshifted).
+const std::string kShiftedTank = std::string(kTank) + R"yaml(  - name: level
+    interval: 0.05
+    reduce: {quantity: surface_height, axis: 1, at: [0.5, 0]}
+)yaml";
+
+TEST(Fluid, TheFreeSurfaceShiftLeavesTheSurfaceInTheWater) {
+  const std::vector<std::string> shift = {"modules[0].fluid.transport_velocity=true",
+                                          "modules[0].fluid.transport_velocity_sweeps=1",
+                                          "output.vtp=false"};
+  auto every = shift;
+  every.push_back("modules[0].fluid.transport_velocity_free_surface=0");
+  every.push_back("end_time=1");
+  EXPECT_THROW(make_simulation(kShiftedTank, every)->run(), HealthError);
+
+  auto surface = shift;
+  surface.push_back("modules[0].fluid.transport_velocity_free_surface=0.95");
+  RunOptions options;
+  options.output_directory =
+      (std::filesystem::path(testing::TempDir()) / "cosph_fluid_shifted_tank").string();
+  auto simulation = make_simulation(kShiftedTank, surface, options);
+  const RunSummary summary = simulation->run();
+  const double level = mean_from(options.output_directory, "level", 1, 0.5);
+  const double middle = mean_from(options.output_directory, "bottom", 2, 0.5);
+  const double kinetic = summary.probes.at("kinetic_energy").at("kinetic_energy");
+  std::cout << "shifted tank: level " << level << ", mid-depth " << middle << " Pa, kinetic energy "
+            << kinetic << " J\n";
+  EXPECT_NEAR(level, 1.0, 1.5 * 0.0158);              // measured 1.0158; unshifted 1.0082
+  EXPECT_GT(level, 1.0082 + 0.5 * 0.0075);            // the layers under the surface were shifted
+  EXPECT_NEAR(middle, 4905.0, 1.5 * 0.076 * 4905.0);  // measured 5,278
+  EXPECT_LT(kinetic, 1e-3 * 1000.0 * 9.81 * 0.5);     // at rest, as the unshifted tank
+  const auto& features = simulation->module(0).info().active_features;
+  EXPECT_NE(std::find(features.begin(), features.end(),
+                      "transport velocity (1 sweeps, free surface left)"),
+            features.end());
 }
 
 // The same tank with the force of the water on its walls: in total it carries the weight
