@@ -162,24 +162,27 @@ void WallSensor<D>::for_each_covered(const ParticleSet<D>& wall, double depth,
 }
 
 // A column counts at the minimum image of its offset from the face's centre (near_face). On a
-// periodic axis shorter than the face plus one particle's share (2 radius + sqrt(D - 1) side, the
-// share's extent along any axis of the plane), two images of one column could both lie under the
-// face, and one of them would not count.
+// periodic axis along which the face plus one particle's share is longer than the period, two
+// images of one column could both lie under the face, and one of them would not count. Along
+// axis a the face and a share span sqrt(1 - n_a^2) (2 radius + sqrt(D - 1) side): nothing along
+// the normal, and in 3D the diagonal of a square share, which is more than an axis-aligned wall's
+// squares need.
 template <int D>
 void WallSensor<D>::require_period(const ParticleSet<D>& wall, const Domain<D>& domain) const {
   if (!domain.any_periodic()) return;
   double side = 0.0;
   for (double v : wall.scalar("volume")) side = std::max(side, std::pow(v, 1.0 / D));
-  const double span = 2.0 * radius_ + std::sqrt(double(D - 1)) * side;
-  for (int a = 0; a < D; ++a)
-    if (domain.periodic[a] && domain.length(a) < span)
-      throw std::invalid_argument(
-          "wall sensor: the periodic axis " + std::to_string(a) + " is " +
-          std::to_string(domain.length(a)) +
-          " long, shorter than the face and one wall particle's " + "share (" +
-          std::to_string(span) +
-          "): a column's two periodic images would both lie under the face; narrow the face or "
-          "lengthen the period");
+  for (int a = 0; a < D; ++a) {
+    const double along_plane = std::sqrt(std::max(0.0, 1.0 - normal_[a] * normal_[a]));
+    const double span = along_plane * (2.0 * radius_ + std::sqrt(double(D - 1)) * side);
+    if (domain.periodic[a] && domain.length(a) < span * (1.0 - 1e-12))
+      throw std::invalid_argument("wall sensor: the periodic axis " + std::to_string(a) + " is " +
+                                  std::to_string(domain.length(a)) +
+                                  " long, shorter than the face with one wall particle's share (" +
+                                  std::to_string(span) +
+                                  "): two periodic images of a column would both lie under the "
+                                  "face; narrow the face or lengthen the period");
+  }
 }
 
 template <int D>

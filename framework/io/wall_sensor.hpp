@@ -51,8 +51,9 @@ class WallSensor {
   // particle still counts (the fluid's kernel support: deeper particles get no force, and a far
   // wall must not count). Offsets, and the separations of the particles near a face, are minimum
   // images on the domain's periodic axes. Throws std::invalid_argument where a periodic axis is
-  // shorter than the face's diameter plus one particle's share: there two images of one column
-  // could both lie under the face, and a minimum image would count one of them only.
+  // shorter than the face's diameter plus one particle's share (as far as the face's plane runs
+  // along it): there two images of one column could both lie under the face, and a minimum image
+  // would count one of them only.
   Coverage coverage(const ParticleSet<D>& wall, double depth, const Domain<D>& domain = {}) const;
   // The pressures, one per sensor (NaN where no particle covers it), from the force on each wall
   // particle.

@@ -851,17 +851,25 @@ class FluidModule final : public Module {
     const auto sets = boundaries();
     const auto views = boundary_views(sets);
     const auto truncated = open_.truncation(fluid_);
-    const double surface = spec_.transport_velocity_free_surface() * reference_number_density_;
+    // The number density below which a particle is held: 0 holds none (confined flows).
+    const double hold_below = spec_.transport_velocity_free_surface() * reference_number_density_;
     held_.assign(x.size(), 0);
     for (int sweep = 0; sweep < spec_.transport_velocity_sweeps(); ++sweep) {
       // The first sweep finds the particles where the lists were built: sum_j V_j grad W_ij =
-      // sum_j V_j (-dW/dr) e_ij from the pair geometry.
+      // sum_j V_j (-dW/dr) e_ij from the pair geometry, and decides which particles are held.
       const bool at_build = sweep == 0;
       parallel_for_each_index(x.size(), [&](std::size_t i) {
         if (held_[i]) return;
-        const Vec<D> sum = at_build ? number_density_gradient_at_build(i, sets, views, surface)
-                                    : number_density_gradient(i, sets, views);
-        held_[i] = held_[i] || truncated(i);
+        Vec<D> sum;
+        if (at_build) {
+          const auto [gradient, density] =
+              number_density_at_build(i, sets, views, hold_below > 0.0);
+          sum = gradient;
+          held_[i] = density < hold_below;
+        } else {
+          sum = number_density_gradient(i, sets, views);
+        }
+        if (truncated(i)) held_[i] = 1;
         shift_[i] = held_[i] ? Vec<D>(Vec<D>::Zero()) : Vec<D>(-0.4 * h * h * sum);
       });
       parallel_stream(x.size(), [&](std::size_t i) { x[i] = wrap(x[i] + shift_[i]); });
@@ -900,31 +908,33 @@ class FluidModule final : public Module {
 
   Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
 
-  // sum_j V_j grad W_ij over the fluid and boundary neighbours of i, from the step's pair
-  // geometry; with a free-surface fraction, marks i as held (held_) where its number density
-  // sum_j V_j W_ij (the self term included) is below `surface`.
-  Vec<D> number_density_gradient_at_build(std::size_t i, const std::vector<BoundarySet<D>*>& sets,
-                                          const std::vector<BoundaryView>& views, double surface) {
+  // sum_j V_j grad W_ij and, with `with_density` (else 0), the number density sum_j V_j W_ij (the
+  // self term included) over the fluid and boundary neighbours of i, from the step's pair
+  // geometry. The volumes are m / rho, as in the shift; the density summation's m / rho0 differs
+  // by p / c^2, a few parts in 10^4. A confined flow's shift holds no particle and skips the
+  // density.
+  std::pair<Vec<D>, double> number_density_at_build(std::size_t i,
+                                                    const std::vector<BoundarySet<D>*>& sets,
+                                                    const std::vector<BoundaryView>& views,
+                                                    bool with_density) const {
     const auto& volume = fluid_.scalar("volume");
-    Vec<D> sum = Vec<D>::Zero();
-    double density = volume[i] * kernel_.value(0.0);
-    const bool count = surface > 0.0;
+    Vec<D> gradient = Vec<D>::Zero();
+    double density = with_density ? volume[i] * kernel_.value(0.0) : 0.0;
     for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
       const double V = volume[inner_.index[k]];
-      sum += (V * inner_geometry_.gradient[k]) * inner_geometry_.direction[k];
-      if (count) density += V * kernel_.value(inner_geometry_.distance[k]);
+      gradient += (V * inner_geometry_.gradient[k]) * inner_geometry_.direction[k];
+      if (with_density) density += V * kernel_.value(inner_geometry_.distance[k]);
     }
     for (std::size_t s = 0; s < sets.size(); ++s) {
       const auto& list = sets[s]->list;
       const auto& g = sets[s]->geometry;
       for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k) {
         const double V = views[s].V[list.index[k]];
-        sum += (V * g.gradient[k]) * g.direction[k];
-        if (count) density += V * kernel_.value(g.distance[k]);
+        gradient += (V * g.gradient[k]) * g.direction[k];
+        if (with_density) density += V * kernel_.value(g.distance[k]);
       }
     }
-    held_[i] = count && density < surface;
-    return sum;
+    return {gradient, density};
   }
 
   // sum_j V_j grad W_ij at the particles' present positions (the sweeps after the first).
