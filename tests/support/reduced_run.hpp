@@ -3,7 +3,10 @@
 // path the full run takes (scene loading, particle generation, neighbour search, pair loops,
 // coupling, sub-stepping, probes, the health monitor) at a cost CI can afford. The accuracy and
 // end-state checks need the whole run, so a reduced test stops before them with GTEST_SKIP,
-// which ctest reports as skipped, not passed. Unset or 0 (the release job): full runs.
+// which ctest reports as skipped, not passed. Unit tests see the variable too; only those that
+// ask reduced_run() (two whole grid-sequenced solves, 251 s and 131 s under the sanitizers while
+// the variable reached validation and stability tests alone) use it. Unset or 0 (the release
+// job): full runs.
 #pragma once
 
 #include <gtest/gtest.h>
