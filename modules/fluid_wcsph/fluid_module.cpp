@@ -44,6 +44,10 @@ class FluidModule final : public Module {
         contact_(name_ + "_contact"),
         open_(spec_, kernel_.support_radius(), sound_speed_, key_) {
     if (spec_.gravity_size() > 0) gravity_ = to_vec<D>(spec_.gravity());
+    if (spec_.transport_velocity_hydrostatic_band() > 0.0 && gravity_.norm() == 0.0)
+      throw ConfigError(key_ + ".transport_velocity_hydrostatic_band",
+                        "a hydrostatic band needs gravity: without it no pressure marks the layer "
+                        "under the free surface");
     for (int a = 0; a < spec_.initial_velocity_size(); ++a)
       initial_velocity_.push_back(
           parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));
@@ -83,7 +87,9 @@ class FluidModule final : public Module {
     if (spec_.transport_velocity())
       f.push_back(
           "transport velocity (" + std::to_string(spec_.transport_velocity_sweeps()) + " sweeps" +
-          (spec_.transport_velocity_free_surface() > 0.0 ? ", free surface left" : "") + ")");
+          (spec_.transport_velocity_free_surface() > 0.0 ? ", free surface left" : "") +
+          (spec_.transport_velocity_hydrostatic_band() > 0.0 ? ", hydrostatic band left" : "") +
+          ")");
     if (spec_.walls_size() > 0) f.push_back("walls (one-sided Riemann)");
     if (spec_.pressure_extension() == "clamped") f.push_back("pressure extension clamped at zero");
     for (const auto& o : open_.features()) f.push_back(o);
@@ -713,27 +719,27 @@ class FluidModule final : public Module {
   // Eq. 12 (free surface: never below the continuity density) or eq. 13 (confined).
   void update_density_by_summation() {
     const auto& x = fluid_.vector("position");
-    const auto& m = fluid_.scalar("mass");
     auto& rho = fluid_.scalar("density");
     const double rho0 = spec_.density(), sigma0 = reference_number_density_;
     const bool free_surface = spec_.density_treatment() == "reinitialisation";
     const auto sets = boundaries();
     const auto views = boundary_views(sets);  // field lookups once, not per particle
     const auto truncated = open_.truncation(fluid_);
+    const bool keep = holds_the_surface();  // the shift's hold test reads the number density
+    if (keep) number_density_.resize(x.size());
     parallel_for_each_index(x.size(), [&](std::size_t i) {
-      double sigma = m[i] / rho0 * kernel_.value(0.0);
-      for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k)
-        sigma += m[inner_.index[k]] / rho0 * kernel_.value(inner_geometry_.distance[k]);
-      for (std::size_t s = 0; s < sets.size(); ++s) {
-        const auto& list = sets[s]->list;
-        const auto& r = sets[s]->geometry.distance;
-        for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k)
-          sigma += views[s].V[list.index[k]] * kernel_.value(r[k]);
-      }
+      const double sigma = number_density(i, sets, views);
+      if (keep) number_density_[i] = sigma;
       const double summed = rho0 * sigma / sigma0;
       rho[i] = free_surface || truncated(i) ? std::max(rho[i], summed) : summed;
     });
     update_pressure();
+  }
+
+  // Whether the transport-velocity shift holds the particles of a free surface by their number
+  // density (transport_velocity_free_surface > 0).
+  bool holds_the_surface() const {
+    return spec_.transport_velocity() && spec_.transport_velocity_free_surface() > 0.0;
   }
 
   void update_pressure() {
@@ -843,7 +849,9 @@ class FluidModule final : public Module {
   // the step stays valid: each sweep moves a particle by a small fraction of h. In a free-surface
   // flow (transport_velocity_free_surface > 0) the particles whose number density at the step's
   // configuration is below that fraction of a full neighbourhood's keep their place over the step's
-  // sweeps: at the surface the shift points out of the water.
+  // sweeps: at the surface the shift points out of the water. So do, with a hydrostatic band, those
+  // whose pressure is below that many spacings' head: the layer under the surface, which the
+  // shifted particles below would otherwise crowd up and dilate.
   void correct_transport_velocity() {
     auto& x = fluid_.vector("position");
     const double h = kernel_.smoothing_length();
@@ -853,7 +861,16 @@ class FluidModule final : public Module {
     const auto truncated = open_.truncation(fluid_);
     // The number density below which a particle is held: 0 holds none (confined flows).
     const double hold_below = spec_.transport_velocity_free_surface() * reference_number_density_;
+    const double band_pressure = spec_.density() * gravity_.norm() * spec_.body().spacing() *
+                                 spec_.transport_velocity_hydrostatic_band();
+    const auto& p = fluid_.scalar("pressure");
     held_.assign(x.size(), 0);
+    // The density summation of this step left the number density; without one, sum it here.
+    if (hold_below > 0.0 && spec_.density_treatment() == "none") {
+      number_density_.resize(x.size());
+      parallel_for_each_index(
+          x.size(), [&](std::size_t i) { number_density_[i] = number_density(i, sets, views); });
+    }
     for (int sweep = 0; sweep < spec_.transport_velocity_sweeps(); ++sweep) {
       // The first sweep finds the particles where the lists were built: sum_j V_j grad W_ij =
       // sum_j V_j (-dW/dr) e_ij from the pair geometry, and decides which particles are held.
@@ -862,10 +879,9 @@ class FluidModule final : public Module {
         if (held_[i]) return;
         Vec<D> sum;
         if (at_build) {
-          const auto [gradient, density] =
-              number_density_at_build(i, sets, views, hold_below > 0.0);
-          sum = gradient;
-          held_[i] = density < hold_below;
+          sum = number_density_gradient_at_build(i, sets, views);
+          held_[i] = (hold_below > 0.0 && number_density_[i] < hold_below) ||
+                     (band_pressure > 0.0 && p[i] < band_pressure);
         } else {
           sum = number_density_gradient(i, sets, views);
         }
@@ -908,33 +924,41 @@ class FluidModule final : public Module {
 
   Vec<D> wrap(const Vec<D>& x) const { return domain_.any_periodic() ? domain_.wrap(x) : x; }
 
-  // sum_j V_j grad W_ij and, with `with_density` (else 0), the number density sum_j V_j W_ij (the
-  // self term included) over the fluid and boundary neighbours of i, from the step's pair
-  // geometry. The volumes are m / rho, as in the shift; the density summation's m / rho0 differs
-  // by p / c^2, a few parts in 10^4. A confined flow's shift holds no particle and skips the
-  // density.
-  std::pair<Vec<D>, double> number_density_at_build(std::size_t i,
-                                                    const std::vector<BoundarySet<D>*>& sets,
-                                                    const std::vector<BoundaryView>& views,
-                                                    bool with_density) const {
+  // sum_j V_j W_ij over the fluid (V_j = m_j / rho0, the self term included) and boundary
+  // neighbours of i, from the step's pair geometry: rho0 times it over a full neighbourhood's is
+  // the summed density (eq. 12, 13).
+  double number_density(std::size_t i, const std::vector<BoundarySet<D>*>& sets,
+                        const std::vector<BoundaryView>& views) const {
+    const auto& m = fluid_.scalar("mass");
+    const double rho0 = spec_.density();
+    double sigma = m[i] / rho0 * kernel_.value(0.0);
+    for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k)
+      sigma += m[inner_.index[k]] / rho0 * kernel_.value(inner_geometry_.distance[k]);
+    for (std::size_t s = 0; s < sets.size(); ++s) {
+      const auto& list = sets[s]->list;
+      const auto& r = sets[s]->geometry.distance;
+      for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k)
+        sigma += views[s].V[list.index[k]] * kernel_.value(r[k]);
+    }
+    return sigma;
+  }
+
+  // sum_j V_j grad W_ij = sum_j V_j (-dW/dr) e_ij (V = m / rho) over the fluid and boundary
+  // neighbours of i, from the step's pair geometry (the first sweep).
+  Vec<D> number_density_gradient_at_build(std::size_t i, const std::vector<BoundarySet<D>*>& sets,
+                                          const std::vector<BoundaryView>& views) const {
     const auto& volume = fluid_.scalar("volume");
     Vec<D> gradient = Vec<D>::Zero();
-    double density = with_density ? volume[i] * kernel_.value(0.0) : 0.0;
-    for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k) {
-      const double V = volume[inner_.index[k]];
-      gradient += (V * inner_geometry_.gradient[k]) * inner_geometry_.direction[k];
-      if (with_density) density += V * kernel_.value(inner_geometry_.distance[k]);
-    }
+    for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k)
+      gradient +=
+          (volume[inner_.index[k]] * inner_geometry_.gradient[k]) * inner_geometry_.direction[k];
     for (std::size_t s = 0; s < sets.size(); ++s) {
       const auto& list = sets[s]->list;
       const auto& g = sets[s]->geometry;
-      for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k) {
-        const double V = views[s].V[list.index[k]];
-        gradient += (V * g.gradient[k]) * g.direction[k];
-        if (with_density) density += V * kernel_.value(g.distance[k]);
-      }
+      for (std::size_t k = list.offset[i]; k < list.offset[i + 1]; ++k)
+        gradient += (views[s].V[list.index[k]] * g.gradient[k]) * g.direction[k];
     }
-    return {gradient, density};
+    return gradient;
   }
 
   // sum_j V_j grad W_ij at the particles' present positions (the sweeps after the first).
@@ -1091,8 +1115,9 @@ class FluidModule final : public Module {
   NeighbourList inner_;
   PairGeometry<D> inner_geometry_;
   std::vector<Vec<D>> dv_, shift_;
-  std::vector<char> held_;       // particles the transport-velocity shift leaves this step
-  std::vector<Vec<D>> viscous_;  // the sub-cycled viscous acceleration
+  std::vector<char> held_;              // particles the transport-velocity shift leaves this step
+  std::vector<double> number_density_;  // sum_j V_j W_ij of the step (with a free-surface hold)
+  std::vector<Vec<D>> viscous_;         // the sub-cycled viscous acceleration
   double contact_density_ = std::numeric_limits<double>::infinity();  // see contact_viscous_dt
   std::vector<double> viscous_volume_;  // m / rho per particle, for the viscous force
   double time_ = 0.0;

@@ -324,6 +324,45 @@ TEST(Fluid, TheFreeSurfaceShiftLeavesTheSurfaceInTheWater) {
             features.end());
 }
 
+// The hydrostatic band on the same tank: holding also the particles within two spacings' head
+// of the surface (p < rho0 g 2 dp = 981 Pa) keeps the shifted layers below from crowding the
+// layer under the surface up. Measured over t = 0.5-2: level 1.0138 (free-surface rule alone
+// 1.0158, unshifted 1.0082), mid-depth 5,147 Pa (+4.9%; free-surface rule alone 5,278, +7.6%).
+// Without gravity the band has no head to measure and is refused, naming the key.
+TEST(Fluid, AHydrostaticBandKeepsTheLayerUnderTheSurfaceFromDilating) {
+  RunOptions options;
+  options.output_directory =
+      (std::filesystem::path(testing::TempDir()) / "cosph_fluid_banded_tank").string();
+  const std::vector<std::string> band = {
+      "modules[0].fluid.transport_velocity=true", "modules[0].fluid.transport_velocity_sweeps=1",
+      "modules[0].fluid.transport_velocity_free_surface=0.95",
+      "modules[0].fluid.transport_velocity_hydrostatic_band=2", "output.vtp=false"};
+  auto simulation = make_simulation(kShiftedTank, band, options);
+  simulation->run();
+  const double level = mean_from(options.output_directory, "level", 1, 0.5);
+  const double middle = mean_from(options.output_directory, "bottom", 2, 0.5);
+  std::cout << "banded tank: level " << level << ", mid-depth " << middle << " Pa\n";
+  EXPECT_NEAR(level, 1.0, 1.5 * 0.0138);
+  EXPECT_LT(level, 1.0158 - 0.5 * 0.0020);            // below the free-surface rule's level
+  EXPECT_NEAR(middle, 4905.0, 1.5 * 0.049 * 4905.0);  // measured 5,147
+  EXPECT_LT(middle, 5278.0 - 0.5 * 131.0);            // below the free-surface rule's 5,278
+  const auto& features = simulation->module(0).info().active_features;
+  EXPECT_NE(std::find(features.begin(), features.end(),
+                      "transport velocity (1 sweeps, free surface left, hydrostatic band left)"),
+            features.end());
+
+  auto weightless = band;
+  weightless.push_back("modules[0].fluid.gravity=[0, 0]");
+  try {
+    make_simulation(kShiftedTank, weightless);
+    ADD_FAILURE() << "a hydrostatic band without gravity was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("modules[0].fluid.transport_velocity_hydrostatic_band"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // The same tank with the force of the water on its walls: in total it carries the weight
 // rho g H W = 9810 N/m, and the left wall (with its corner) the thrust rho g H^2 / 2 = 4905 N/m.
 // The water rings acoustically (period 4 H / c = 0.09): the forces are averaged over t = 0.5-1.
