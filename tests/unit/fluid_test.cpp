@@ -324,6 +324,26 @@ TEST(Fluid, TheFreeSurfaceShiftLeavesTheSurfaceInTheWater) {
             features.end());
 }
 
+// Without a density summation (density_treatment: none) the shift sums the number density its
+// hold test reads itself: the tank keeps its surface and its shifted layers (level 1.0175 over
+// t = 0.5-2; holding every particle would leave the unshifted 1.0082, shifting every one fails).
+TEST(Fluid, TheFreeSurfaceShiftSumsItsOwnNumberDensityWithoutADensitySummation) {
+  RunOptions options;
+  options.output_directory =
+      (std::filesystem::path(testing::TempDir()) / "cosph_fluid_shifted_tank_continuity").string();
+  make_simulation(
+      kShiftedTank,
+      {"modules[0].fluid.transport_velocity=true", "modules[0].fluid.transport_velocity_sweeps=1",
+       "modules[0].fluid.transport_velocity_free_surface=0.95",
+       "modules[0].fluid.density_treatment=none", "output.vtp=false"},
+      options)
+      ->run();
+  const double level = mean_from(options.output_directory, "level", 1, 0.5);
+  std::cout << "shifted tank without a density summation: level " << level << "\n";
+  EXPECT_NEAR(level, 1.0, 1.5 * 0.0175);    // measured 1.0175
+  EXPECT_GT(level, 1.0082 + 0.5 * 0.0093);  // the layers under the surface were shifted
+}
+
 // The hydrostatic band on the same tank: holding also the particles within two spacings' head
 // of the surface (p < rho0 g 2 dp = 981 Pa) keeps the shifted layers below from crowding the
 // layer under the surface up. Measured over t = 0.5-2: level 1.0138 (free-surface rule alone
