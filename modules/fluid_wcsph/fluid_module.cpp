@@ -719,16 +719,17 @@ class FluidModule final : public Module {
   // Eq. 12 (free surface: never below the continuity density) or eq. 13 (confined).
   void update_density_by_summation() {
     const auto& x = fluid_.vector("position");
+    const auto& m = fluid_.scalar("mass");
     auto& rho = fluid_.scalar("density");
     const double rho0 = spec_.density(), sigma0 = reference_number_density_;
     const bool free_surface = spec_.density_treatment() == "reinitialisation";
     const auto sets = boundaries();
     const auto views = boundary_views(sets);  // field lookups once, not per particle
     const auto truncated = open_.truncation(fluid_);
-    const bool keep = holds_the_surface();  // the shift's hold test reads the number density
+    const bool keep = holds_by_number_density();  // the shift's hold test reads it
     if (keep) number_density_.resize(x.size());
     parallel_for_each_index(x.size(), [&](std::size_t i) {
-      const double sigma = number_density(i, sets, views);
+      const double sigma = number_density(i, m, sets, views);
       if (keep) number_density_[i] = sigma;
       const double summed = rho0 * sigma / sigma0;
       rho[i] = free_surface || truncated(i) ? std::max(rho[i], summed) : summed;
@@ -738,7 +739,7 @@ class FluidModule final : public Module {
 
   // Whether the transport-velocity shift holds the particles of a free surface by their number
   // density (transport_velocity_free_surface > 0).
-  bool holds_the_surface() const {
+  bool holds_by_number_density() const {
     return spec_.transport_velocity() && spec_.transport_velocity_free_surface() > 0.0;
   }
 
@@ -866,10 +867,11 @@ class FluidModule final : public Module {
     const auto& p = fluid_.scalar("pressure");
     held_.assign(x.size(), 0);
     // The density summation of this step left the number density; without one, sum it here.
-    if (hold_below > 0.0 && spec_.density_treatment() == "none") {
+    if (holds_by_number_density() && spec_.density_treatment() == "none") {
+      const auto& m = fluid_.scalar("mass");
       number_density_.resize(x.size());
       parallel_for_each_index(
-          x.size(), [&](std::size_t i) { number_density_[i] = number_density(i, sets, views); });
+          x.size(), [&](std::size_t i) { number_density_[i] = number_density(i, m, sets, views); });
     }
     for (int sweep = 0; sweep < spec_.transport_velocity_sweeps(); ++sweep) {
       // The first sweep finds the particles where the lists were built: sum_j V_j grad W_ij =
@@ -927,9 +929,9 @@ class FluidModule final : public Module {
   // sum_j V_j W_ij over the fluid (V_j = m_j / rho0, the self term included) and boundary
   // neighbours of i, from the step's pair geometry: rho0 times it over a full neighbourhood's is
   // the summed density (eq. 12, 13).
-  double number_density(std::size_t i, const std::vector<BoundarySet<D>*>& sets,
+  double number_density(std::size_t i, const std::vector<double>& m,
+                        const std::vector<BoundarySet<D>*>& sets,
                         const std::vector<BoundaryView>& views) const {
-    const auto& m = fluid_.scalar("mass");
     const double rho0 = spec_.density();
     double sigma = m[i] / rho0 * kernel_.value(0.0);
     for (std::size_t k = inner_.offset[i]; k < inner_.offset[i + 1]; ++k)
