@@ -156,6 +156,20 @@ TEST(WallSensor, APeriodShorterThanTheFaceAndOneShareIsRefused) {
   }
 }
 
+// A period along the face's normal does not bound the face: the face has no extent there. A face
+// of 1.9 (2.0 with one particle's share) facing along y, in a domain periodic along y with a period
+// of 1.5, reads its uniform pressure; the far wall (y = 2.05-2.25) lies 0.55-0.75 above the face
+// or 0.75-0.95 below it through the period, both beyond the wall's depth of 0.35.
+TEST(WallSensor, APeriodAlongTheNormalDoesNotLimitTheFace) {
+  const Wall<2> wall([](const Vec<2>&) { return 1.0; });
+  Domain<2> domain;
+  domain.lower = Vec<2>(-3.0, -1.0);
+  domain.upper = Vec<2>(3.0, 0.5);
+  domain.periodic = {false, true};
+  const WallSensor<2> sensor({Vec<2>(0.0, 0.0)}, Vec<2>::Unit(1), 1.9);
+  EXPECT_NEAR(sensor.sample(wall.particles, wall.force, 0.35, domain)[0], 1.0, 1e-12);
+}
+
 // The corner's particles find their receivers across a periodic seam. A wall two columns wide
 // (x in [0.8, 1]) stands on the periodic floor; the face (x in [-0.95, 0.95], over part of that
 // wall only to put the corner on the far side of the centre from the face's other end) takes the
