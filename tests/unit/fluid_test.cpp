@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
+#include <string>
 #include <vector>
 
 #include "../support/probe_csv.hpp"
@@ -293,17 +295,24 @@ const std::string kShiftedTank = std::string(kTank) + R"yaml(  - name: level
     reduce: {quantity: surface_height, axis: 1, at: [0.5, 0]}
 )yaml";
 
-TEST(Fluid, TheFreeSurfaceShiftLeavesTheSurfaceInTheWater) {
-  const std::vector<std::string> shift = {"modules[0].fluid.transport_velocity=true",
-                                          "modules[0].fluid.transport_velocity_sweeps=1",
-                                          "output.vtp=false"};
-  auto every = shift;
-  every.push_back("modules[0].fluid.transport_velocity_free_surface=0");
-  every.push_back("end_time=1");
-  EXPECT_THROW(make_simulation(kShiftedTank, every)->run(), HealthError);
+// The tank tests' shift: one sweep per step, files off, and `more` on top.
+std::vector<std::string> one_sweep_shift(std::initializer_list<std::string> more) {
+  std::vector<std::string> set = {"modules[0].fluid.transport_velocity=true",
+                                  "modules[0].fluid.transport_velocity_sweeps=1",
+                                  "output.vtp=false"};
+  set.insert(set.end(), more);
+  return set;
+}
 
-  auto surface = shift;
-  surface.push_back("modules[0].fluid.transport_velocity_free_surface=0.95");
+TEST(Fluid, TheFreeSurfaceShiftLeavesTheSurfaceInTheWater) {
+  EXPECT_THROW(
+      make_simulation(
+          kShiftedTank,
+          one_sweep_shift({"modules[0].fluid.transport_velocity_free_surface=0", "end_time=1"}))
+          ->run(),
+      HealthError);
+
+  const auto surface = one_sweep_shift({"modules[0].fluid.transport_velocity_free_surface=0.95"});
   RunOptions options;
   options.output_directory =
       (std::filesystem::path(testing::TempDir()) / "cosph_fluid_shifted_tank").string();
@@ -331,12 +340,10 @@ TEST(Fluid, TheFreeSurfaceShiftSumsItsOwnNumberDensityWithoutADensitySummation) 
   RunOptions options;
   options.output_directory =
       (std::filesystem::path(testing::TempDir()) / "cosph_fluid_shifted_tank_continuity").string();
-  make_simulation(
-      kShiftedTank,
-      {"modules[0].fluid.transport_velocity=true", "modules[0].fluid.transport_velocity_sweeps=1",
-       "modules[0].fluid.transport_velocity_free_surface=0.95",
-       "modules[0].fluid.density_treatment=none", "output.vtp=false"},
-      options)
+  make_simulation(kShiftedTank,
+                  one_sweep_shift({"modules[0].fluid.transport_velocity_free_surface=0.95",
+                                   "modules[0].fluid.density_treatment=none"}),
+                  options)
       ->run();
   const double level = mean_from(options.output_directory, "level", 1, 0.5);
   std::cout << "shifted tank without a density summation: level " << level << "\n";
@@ -353,10 +360,8 @@ TEST(Fluid, AHydrostaticBandKeepsTheLayerUnderTheSurfaceFromDilating) {
   RunOptions options;
   options.output_directory =
       (std::filesystem::path(testing::TempDir()) / "cosph_fluid_banded_tank").string();
-  const std::vector<std::string> band = {
-      "modules[0].fluid.transport_velocity=true", "modules[0].fluid.transport_velocity_sweeps=1",
-      "modules[0].fluid.transport_velocity_free_surface=0.95",
-      "modules[0].fluid.transport_velocity_hydrostatic_band=2", "output.vtp=false"};
+  const auto band = one_sweep_shift({"modules[0].fluid.transport_velocity_free_surface=0.95",
+                                     "modules[0].fluid.transport_velocity_hydrostatic_band=2"});
   auto simulation = make_simulation(kShiftedTank, band, options);
   simulation->run();
   const double level = mean_from(options.output_directory, "level", 1, 0.5);
