@@ -243,18 +243,54 @@ def _overrides(node: Any, where: str) -> dict:
 def load_study(path: Path) -> Study:
     """Reads and validates a study file; raises StudyError naming the offending key."""
     path = Path(path)
+    root = _read_yaml(path)
+    try:
+        return _parse_study(path, _with_runs_of(path, root))
+    except StudyError as error:
+        raise StudyError(f"{path}: {error}") from None
+
+
+def _read_yaml(path: Path) -> Any:
     try:
         text = path.read_text()
     except OSError as error:
         raise StudyError(f"{path}: cannot read: {error.strerror}") from None
     try:
-        root = yaml.load(text, Loader=_UniqueKeyLoader)
+        return yaml.load(text, Loader=_UniqueKeyLoader)
     except yaml.YAMLError as error:
         raise StudyError(f"{path}: not valid YAML: {error}") from None
-    try:
-        return _parse_study(path, root)
-    except StudyError as error:
-        raise StudyError(f"{path}: {error}") from None
+
+
+# What makes a study's runs. A study that compares another quantity of another study's runs names
+# that study in `runs_of` and takes these from it, so the two cannot drift apart (and the run
+# cache runs them once).
+RUN_KEYS = ("scene", "overrides", "sweep", "ensemble", "repeat", "timeout")
+
+
+def _with_runs_of(path: Path, root: Any) -> Any:
+    """The study's keys with those of RUN_KEYS taken from the study its `runs_of` names."""
+    if not isinstance(root, dict) or "runs_of" not in root:
+        return root
+    source = root["runs_of"]
+    if not isinstance(source, str):
+        raise StudyError(f"runs_of: expected the path of a study file, got {source!r}")
+    for key in RUN_KEYS:
+        if key in root:
+            raise StudyError(f"{key}: comes from runs_of's study ({source}); a study that reads "
+                             "another's runs does not set it")
+    base_path = (path.parent / source).resolve()
+    if not base_path.is_file():
+        raise StudyError(f"runs_of: no such file: {base_path}")
+    base = _read_yaml(base_path)
+    if not isinstance(base, dict) or "scene" not in base:
+        raise StudyError(f"runs_of: {base_path} is not a study with a scene")
+    if "runs_of" in base:
+        raise StudyError(f"runs_of: {base_path} reads another study's runs itself; name that one")
+    merged = {key: value for key, value in root.items() if key != "runs_of"}
+    merged.update({key: base[key] for key in RUN_KEYS if key in base})
+    if isinstance(merged["scene"], str):  # relative to the file that names it
+        merged["scene"] = str((base_path.parent / merged["scene"]).resolve())
+    return merged
 
 
 def _parse_study(path: Path, root: Any) -> Study:

@@ -250,5 +250,65 @@ class Ensemble(unittest.TestCase):
                 study.load_study(root / "study.yaml")
 
 
+class RunsOf(unittest.TestCase):
+    """A study that reads another study's runs takes what makes them (scene, overrides, sweep,
+    ensemble, repeat, timeout) from that study's file, and sets none of it itself."""
+
+    BASE = """title: base
+description: d
+scene: ../scenes/scene.yaml
+overrides: {end_time: 3}
+sweep: {axes: [{key: a, values: [1, 2]}]}
+ensemble: {key: output.interval, values: [0.5, 0.7]}
+repeat: 2
+timeout: 600
+quantity: {probe: tip, kind: final, column: z}
+reference: {value: 4.17, source: s}
+norm: relative_at_point
+"""
+    READER = """title: reader
+description: d
+runs_of: {source}
+quantity: {{probe: tip, kind: final, column: z}}
+reference: {{value: 1.0, source: s}}
+norm: relative_at_point
+{extra}"""
+
+    def load(self, source="../../base/base.yaml", extra="", base=BASE):
+        with tempfile.TemporaryDirectory() as directory:
+            root = Path(directory)
+            for folder in ("scenes", "base", "readers/deeper"):
+                (root / folder).mkdir(parents=True)
+            (root / "scenes" / "scene.yaml").write_text(ComparisonsAndBand.SCENE)
+            (root / "base" / "base.yaml").write_text(base)
+            (root / "base" / "chained.yaml").write_text("runs_of: base.yaml\n" + base)
+            path = root / "readers" / "deeper" / "reader.yaml"
+            path.write_text(self.READER.format(source=source, extra=extra))
+            loaded = study.load_study(path)
+            return loaded, study.load_study(root / "base" / "base.yaml")
+
+    def test_takes_the_runs_from_the_named_study(self):
+        reader, base = self.load()
+        self.assertEqual(reader.scene, base.scene)  # relative to the base's file, not the reader's
+        self.assertEqual(reader.overrides, {"end_time": 3})
+        self.assertEqual([m.overrides for m in study.ensemble_members(reader, reader.points()[1])],
+                         [m.overrides for m in study.ensemble_members(base, base.points()[1])])
+        self.assertEqual((reader.repeat, reader.timeout), (2, 600.0))
+        self.assertEqual((reader.title, reader.reference.value), ("reader", 1.0))
+
+    def test_refuses_run_keys_of_its_own_a_chain_and_a_missing_file(self):
+        refused = [
+            ("sweep: comes from runs_of's study", {"extra": "sweep: {axes: []}"}),
+            ("overrides: comes from runs_of's study", {"extra": "overrides: {b: 1}"}),
+            ("runs_of: no such file", {"source": "../../base/none.yaml"}),
+            ("reads another study's runs itself", {"source": "../../base/chained.yaml"}),
+            ("runs_of: expected the path of a study file", {"source": "[1, 2]"}),
+            ("is not a study with a scene", {"base": "title: t\n"}),
+        ]
+        for message, options in refused:
+            with self.subTest(message=message), self.assertRaisesRegex(study.StudyError, message):
+                self.load(**options)
+
+
 if __name__ == "__main__":
     unittest.main()
