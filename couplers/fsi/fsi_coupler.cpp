@@ -49,6 +49,11 @@ std::string find_port(const ModuleInfo& info, bool writes, const std::string& po
 //     that force held;
 //  4. its average velocity (displacement / dt_ac) and acceleration (velocity change / dt_ac) over
 //     them, with its new positions, go to the fluid's contact set.
+// After the last sub-step the solid is handed the force averaged over the step's sub-steps (each
+// weighted by its length), so that what it holds between steps — its `external_force` output, a
+// drag or lift probe — carries the impulse it received over the step. The last sub-step's force
+// alone is one phase of the fluid's cycle within the step. Every sub-step reads its own force
+// before the solid moves, so the motion is unchanged by this.
 // Checkpoints fall between coupler steps; the averages are the coupler's own state (they cannot
 // be recomputed from the solid's), and every input is sent again after a restart.
 class FsiCoupler final : public Coupler {
@@ -98,6 +103,7 @@ class FsiCoupler final : public Coupler {
       fluid().substep(dt);
       fluid().write(force_port_, force_);
       solid().read(external_force_port_, force_);
+      add_impulse(dt);
       const double solid_dt = solid().max_dt();
       if (!(solid_dt > 0.0) || !std::isfinite(solid_dt))
         throw RuntimeError("FSI coupler: the solid's stable step is " + significant(solid_dt) +
@@ -120,6 +126,7 @@ class FsiCoupler final : public Coupler {
       ++acoustic_steps_;
       solid_substeps_ += kappa;
     }
+    hand_mean_force();
     fluid().end_step();
   }
 
@@ -193,6 +200,25 @@ class FsiCoupler final : public Coupler {
     }
   }
 
+  // The force of the sub-step just taken, times its length, added to the step's impulse.
+  void add_impulse(double dt) {
+    const auto& f = force_.arrays.at("force").values;
+    if (impulse_time_ == 0.0) impulse_.assign(f.size(), 0.0);
+    if (impulse_.size() != f.size())
+      throw RuntimeError("FSI: the fluid's contact force changed its size within a step");
+    for (std::size_t c = 0; c < f.size(); ++c) impulse_[c] += f[c] * dt;
+    impulse_time_ += dt;
+  }
+
+  // The step's mean force to the solid, and the impulse emptied for the next step.
+  void hand_mean_force() {
+    if (!(impulse_time_ > 0.0)) return;
+    auto& f = force_.arrays.at("force").values;
+    for (std::size_t c = 0; c < f.size(); ++c) f[c] = impulse_[c] / impulse_time_;
+    solid().read(external_force_port_, force_);
+    impulse_time_ = 0.0;
+  }
+
   void send_contact() {
     contact_.points = after_.points;
     contact_.arrays["position"] = after_.arrays.at("position");
@@ -215,6 +241,8 @@ class FsiCoupler final : public Coupler {
   FieldBuffer before_, after_, force_, contact_;
   static constexpr double kMaxSubsteps = 1e6;
   std::vector<double> velocity_average_, acceleration_average_;
+  std::vector<double> impulse_;  // the open step's force times time, per force component
+  double impulse_time_ = 0.0;
   long long acoustic_steps_ = 0, solid_substeps_ = 0;
 };
 

@@ -86,20 +86,29 @@ void build_pairs_of(BoundarySet<D>& b) {
   for (std::size_t k = 0; k < pairs; ++k) b.pairs_of.index[next[b.list.index[k]]++] = Index(k);
 }
 
+// Sums a per-pair value over each boundary particle's pairs, in ascending pair order (zero where
+// the set has no pair transpose yet). add(sum, k) adds pair k's share to sum.
+template <int D, class AddPair>
+std::vector<Vec<D>> gather_pairs(const BoundarySet<D>& b, AddPair add) {
+  std::vector<Vec<D>> sum(b.particles.size(), Vec<D>::Zero());
+  if (b.pairs_of.offset.size() != sum.size() + 1) return sum;
+  for (std::size_t w = 0; w < sum.size(); ++w)
+    for (Index k : b.pairs_of.of(w)) add(sum[w], k);
+  return sum;
+}
+
 // The recorded force on every boundary particle (zero before the fluid's first sub-step).
 template <int D>
 std::vector<Vec<D>> recorded_force(const BoundarySet<D>& b) {
-  std::vector<Vec<D>> force(b.particles.size(), Vec<D>::Zero());
   const std::size_t pairs = b.list.pair_count();
   const bool pressure = b.pair_pressure_force.size() == pairs,
              viscous = b.pair_viscous_force.size() == pairs;
-  if (b.pairs_of.offset.size() != force.size() + 1) return force;
-  for (std::size_t w = 0; w < force.size(); ++w)
-    for (Index k : b.pairs_of.of(w)) {
-      if (pressure) force[w] += b.pair_pressure_force[k];
-      if (viscous) force[w] += b.pair_viscous_force[k];
-    }
-  return force;
+  // Pressure before viscous, pair by pair: the order a coupler's contact force was always summed
+  // in.
+  return gather_pairs(b, [&](Vec<D>& force, Index k) {
+    if (pressure) force += b.pair_pressure_force[k];
+    if (viscous) force += b.pair_viscous_force[k];
+  });
 }
 
 // The mean recorded force on every boundary particle over the sub-steps pair_impulse covers (the
@@ -108,12 +117,9 @@ template <int D>
 std::vector<Vec<D>> mean_recorded_force(const BoundarySet<D>& b) {
   if (!(b.impulse_time > 0.0) || b.pair_impulse.size() != b.list.pair_count())
     return recorded_force(b);
-  std::vector<Vec<D>> force(b.particles.size(), Vec<D>::Zero());
-  if (b.pairs_of.offset.size() != force.size() + 1) return force;
-  for (std::size_t w = 0; w < force.size(); ++w) {
-    for (Index k : b.pairs_of.of(w)) force[w] += b.pair_impulse[k];
-    force[w] /= b.impulse_time;
-  }
+  std::vector<Vec<D>> force =
+      gather_pairs(b, [&](Vec<D>& sum, Index k) { sum += b.pair_impulse[k]; });
+  for (Vec<D>& f : force) f /= b.impulse_time;
   return force;
 }
 

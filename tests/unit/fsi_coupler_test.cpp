@@ -199,6 +199,86 @@ TEST(FsiCoupler, WorkOfTheFluidForceIsTheSolidsEnergyChange) {
   EXPECT_NEAR(e1 - e0, meter->work, 1e-4 * meter->work);
 }
 
+// Forwards every call to the solid, adding up the impulse of the external force it is given over
+// each advance (force times the advance's length, per component), and counting the forces.
+class ImpulseMeter final : public Module {
+ public:
+  explicit ImpulseMeter(std::unique_ptr<Module> solid) : solid_(std::move(solid)) {}
+  // The last force the solid was handed, the one before it, and the impulse and time since the
+  // test last emptied them.
+  std::vector<double> impulse, force, previous;
+  double elapsed = 0.0;
+  int forces = 0;
+
+  ModuleInfo info() const override { return solid_->info(); }
+  void initialize() override { solid_->initialize(); }
+  double max_dt() const override { return solid_->max_dt(); }
+  void advance(double dt) override {
+    impulse.resize(force.size(), 0.0);
+    for (std::size_t c = 0; c < force.size(); ++c) impulse[c] += force[c] * dt;
+    elapsed += dt;
+    solid_->advance(dt);
+  }
+  double time() const override { return solid_->time(); }
+  void write(const std::string& port, FieldBuffer& out) const override { solid_->write(port, out); }
+  void read(const std::string& port, const FieldBuffer& in) override {
+    if (port == "external_force") {
+      previous = std::move(force);
+      force = in.arrays.at("force").values;
+      ++forces;
+    }
+    solid_->read(port, in);
+  }
+  void save(StateRecord& state) const override { solid_->save(state); }
+  void load(const StateRecord& state) override { solid_->load(state); }
+  void prepare_output() override { solid_->prepare_output(); }
+  void bodies(BodyViews& views) const override { solid_->bodies(views); }
+  std::size_t particle_count() const override { return solid_->particle_count(); }
+
+ private:
+  std::unique_ptr<Module> solid_;
+};
+
+// What the solid holds after a coupler step (its `external_force` output, a drag probe's input)
+// is the step's mean force: times the step it is the impulse the solid received over the step's
+// acoustic sub-steps, to round-off. The last sub-step's force alone, handed over before, is one
+// phase of the fluid's cycle within the step.
+TEST(FsiCoupler, TheSolidHoldsTheStepsMeanForceAfterEachStep) {
+  const LoadedScene scene = load_scene_text(kCollision, "collision.yaml");
+  std::vector<std::unique_ptr<Module>> children = collision_modules(scene);
+  auto meter_owned = std::make_unique<ImpulseMeter>(std::move(children[1]));
+  ImpulseMeter* meter = meter_owned.get();
+  children[1] = std::move(meter_owned);
+  auto coupler =
+      make_fsi_coupler(scene.scene.couplers(0), std::move(children), {&scene.scene, "couplers[0]"});
+  coupler->initialize();
+  // The largest gaps over the run, and the largest mean force component (their scale).
+  double held_gap = 0.0, last_substep_gap = 0.0, scale = 0.0;
+  for (int step = 0; step < 60; ++step) {
+    meter->impulse.assign(meter->impulse.size(), 0.0);
+    meter->elapsed = 0.0;
+    meter->forces = 0;
+    coupler->advance(coupler->max_dt());
+    ASSERT_GE(meter->forces, 3) << "step " << step << ": the test needs two sub-steps or more";
+    for (std::size_t c = 0; c < meter->force.size(); ++c) {
+      const double mean = meter->impulse[c] / meter->elapsed;
+      scale = std::max(scale, std::abs(mean));
+      held_gap = std::max(held_gap, std::abs(meter->force[c] - mean));
+      last_substep_gap = std::max(last_substep_gap, std::abs(meter->previous[c] - mean));
+    }
+  }
+  ASSERT_GT(scale, 0.0) << "the water never reached the block";
+  held_gap /= scale;
+  last_substep_gap /= scale;
+  std::cout << "largest gap to the step's impulse / time: the held force " << held_gap
+            << ", the last sub-step's " << last_substep_gap << " (of the largest mean component)\n";
+  // Measured: 3.0e-16.
+  EXPECT_LT(held_gap, 1e-15);
+  // The test bites: at the impact the last sub-step's force is far from the step's mean.
+  // Measured: 3.18 (the held force read this before the coupler handed over the mean).
+  EXPECT_GT(last_substep_gap, 2.0);
+}
+
 // ---- Restart and threads -------------------------------------------------------------------
 
 const char* kGate = COSPH_SOURCE_DIR "/examples/fsi_elastic_gate.yaml";
