@@ -68,6 +68,8 @@ struct BoundarySet {
   // carry, 0.74% with the free-surface shift, where the mean reads within 0.002% of it, and the
   // Re = 100 cylinder's drag 10% under the mean at D/20.
   std::vector<Vec<D>> pair_impulse;
+  // The viscous share of pair_impulse alone (walls with the `wall_viscous_force` output).
+  std::vector<Vec<D>> pair_viscous_impulse;
   double impulse_time = 0.0;
 
   bool empty() const { return particles.size() == 0; }
@@ -111,16 +113,25 @@ std::vector<Vec<D>> recorded_force(const BoundarySet<D>& b) {
   });
 }
 
+// The mean force on every boundary particle over the sub-steps impulse_time covers, from per-pair
+// impulses (pair_impulse or its viscous share; zero before the first sub-step or where the
+// impulses do not match the pair list).
+template <int D>
+std::vector<Vec<D>> mean_pair_force(const BoundarySet<D>& b, const std::vector<Vec<D>>& impulse) {
+  if (!(b.impulse_time > 0.0) || impulse.size() != b.list.pair_count())
+    return std::vector<Vec<D>>(b.particles.size(), Vec<D>::Zero());
+  std::vector<Vec<D>> force = gather_pairs(b, [&](Vec<D>& sum, Index k) { sum += impulse[k]; });
+  for (Vec<D>& f : force) f /= b.impulse_time;
+  return force;
+}
+
 // The mean recorded force on every boundary particle over the sub-steps pair_impulse covers (the
 // last sub-step's, recorded_force, where it covers none).
 template <int D>
 std::vector<Vec<D>> mean_recorded_force(const BoundarySet<D>& b) {
   if (!(b.impulse_time > 0.0) || b.pair_impulse.size() != b.list.pair_count())
     return recorded_force(b);
-  std::vector<Vec<D>> force =
-      gather_pairs(b, [&](Vec<D>& sum, Index k) { sum += b.pair_impulse[k]; });
-  for (Vec<D>& f : force) f /= b.impulse_time;
-  return force;
+  return mean_pair_force(b, b.pair_impulse);
 }
 
 // The state a boundary particle w presents to fluid particle i: the fluid's velocity mirrored

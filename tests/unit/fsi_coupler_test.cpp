@@ -128,12 +128,16 @@ TEST(FsiCoupler, ALightBlockInAViscousFluidStaysFinite) {
   EXPECT_LT(collision_momentum_change({"modules[0].fluid.viscosity=500"}), 4.2e-15);
 }
 
-// Forwards every call to the solid, adding up the work of the external force it is given over
-// each advance: sum_i F_i . (x_i(after) - x_i(before)).
-class WorkMeter final : public Module {
+// Forwards every call to the solid, measuring the external force it is handed: the work it does
+// over each advance, sum_i F_i . (x_i(after) - x_i(before)), and its impulse (force times the
+// advance's length, per component) over the time `elapsed`; the last force, the one before it,
+// and how many were handed. A test empties what it measures when it likes.
+class ForceMeter final : public Module {
  public:
-  explicit WorkMeter(std::unique_ptr<Module> solid) : solid_(std::move(solid)) {}
-  double work = 0.0;
+  explicit ForceMeter(std::unique_ptr<Module> solid) : solid_(std::move(solid)) {}
+  double work = 0.0, elapsed = 0.0;
+  std::vector<double> impulse, force, previous;
+  int forces = 0;
 
   ModuleInfo info() const override { return solid_->info(); }
   void initialize() override { solid_->initialize(); }
@@ -145,79 +149,12 @@ class WorkMeter final : public Module {
     solid_->write("particles", after);
     const auto& x0 = before.arrays.at("position").values;
     const auto& x1 = after.arrays.at("position").values;
-    for (std::size_t c = 0; c < x0.size(); ++c) work += force_[c] * (x1[c] - x0[c]);
-  }
-  double time() const override { return solid_->time(); }
-  void write(const std::string& port, FieldBuffer& out) const override { solid_->write(port, out); }
-  void read(const std::string& port, const FieldBuffer& in) override {
-    if (port == "external_force") force_ = in.arrays.at("force").values;
-    solid_->read(port, in);
-  }
-  void save(StateRecord& state) const override { solid_->save(state); }
-  void load(const StateRecord& state) override { solid_->load(state); }
-  void prepare_output() override { solid_->prepare_output(); }
-  void bodies(BodyViews& views) const override { solid_->bodies(views); }
-  std::size_t particle_count() const override { return solid_->particle_count(); }
-
- private:
-  std::unique_ptr<Module> solid_;
-  std::vector<double> force_;
-};
-
-// Kinetic plus strain energy of the solid.
-double solid_energy(Module& solid) {
-  solid.prepare_output();
-  BodyViews views;
-  solid.bodies(views);
-  const auto& p = *views.bodies2.at(0).particles;
-  double e = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    e += 0.5 * p.scalar("mass")[i] * p.vector("velocity")[i].squaredNorm() +
-         p.scalar("strain_energy")[i] * p.scalar("volume")[i];
-  return e;
-}
-
-TEST(FsiCoupler, WorkOfTheFluidForceIsTheSolidsEnergyChange) {
-  const LoadedScene scene = load_scene_text(kCollision, "collision.yaml");
-  std::vector<std::unique_ptr<Module>> children = collision_modules(scene);
-  auto meter_owned = std::make_unique<WorkMeter>(std::move(children[1]));
-  WorkMeter* meter = meter_owned.get();
-  children[1] = std::move(meter_owned);
-  auto coupler =
-      make_fsi_coupler(scene.scene.couplers(0), std::move(children), {&scene.scene, "couplers[0]"});
-  coupler->initialize();
-  // Up to the impact, then over the steps in which the water pushes the block.
-  while (meter->work == 0.0) coupler->advance(coupler->max_dt());
-  const double e0 = solid_energy(*meter);
-  meter->work = 0.0;
-  for (int step = 0; step < 20; ++step) coupler->advance(coupler->max_dt());
-  const double e1 = solid_energy(*meter);
-  std::cout << "work on the solid " << meter->work << " J/m, its energy change " << e1 - e0
-            << " J/m\n";
-  EXPECT_GT(meter->work, 1e-4);
-  // Measured: 1.73778 against 1.73767 (6.3e-5 relative, the solid's O(dt^2) Verlet energy error).
-  EXPECT_NEAR(e1 - e0, meter->work, 1e-4 * meter->work);
-}
-
-// Forwards every call to the solid, adding up the impulse of the external force it is given over
-// each advance (force times the advance's length, per component), and counting the forces.
-class ImpulseMeter final : public Module {
- public:
-  explicit ImpulseMeter(std::unique_ptr<Module> solid) : solid_(std::move(solid)) {}
-  // The last force the solid was handed, the one before it, and the impulse and time since the
-  // test last emptied them.
-  std::vector<double> impulse, force, previous;
-  double elapsed = 0.0;
-  int forces = 0;
-
-  ModuleInfo info() const override { return solid_->info(); }
-  void initialize() override { solid_->initialize(); }
-  double max_dt() const override { return solid_->max_dt(); }
-  void advance(double dt) override {
     impulse.resize(force.size(), 0.0);
-    for (std::size_t c = 0; c < force.size(); ++c) impulse[c] += force[c] * dt;
+    for (std::size_t c = 0; c < x0.size(); ++c) {
+      work += force[c] * (x1[c] - x0[c]);
+      impulse[c] += force[c] * dt;
+    }
     elapsed += dt;
-    solid_->advance(dt);
   }
   double time() const override { return solid_->time(); }
   void write(const std::string& port, FieldBuffer& out) const override { solid_->write(port, out); }
@@ -239,6 +176,41 @@ class ImpulseMeter final : public Module {
   std::unique_ptr<Module> solid_;
 };
 
+// Kinetic plus strain energy of the solid.
+double solid_energy(Module& solid) {
+  solid.prepare_output();
+  BodyViews views;
+  solid.bodies(views);
+  const auto& p = *views.bodies2.at(0).particles;
+  double e = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    e += 0.5 * p.scalar("mass")[i] * p.vector("velocity")[i].squaredNorm() +
+         p.scalar("strain_energy")[i] * p.scalar("volume")[i];
+  return e;
+}
+
+TEST(FsiCoupler, WorkOfTheFluidForceIsTheSolidsEnergyChange) {
+  const LoadedScene scene = load_scene_text(kCollision, "collision.yaml");
+  std::vector<std::unique_ptr<Module>> children = collision_modules(scene);
+  auto meter_owned = std::make_unique<ForceMeter>(std::move(children[1]));
+  ForceMeter* meter = meter_owned.get();
+  children[1] = std::move(meter_owned);
+  auto coupler =
+      make_fsi_coupler(scene.scene.couplers(0), std::move(children), {&scene.scene, "couplers[0]"});
+  coupler->initialize();
+  // Up to the impact, then over the steps in which the water pushes the block.
+  while (meter->work == 0.0) coupler->advance(coupler->max_dt());
+  const double e0 = solid_energy(*meter);
+  meter->work = 0.0;
+  for (int step = 0; step < 20; ++step) coupler->advance(coupler->max_dt());
+  const double e1 = solid_energy(*meter);
+  std::cout << "work on the solid " << meter->work << " J/m, its energy change " << e1 - e0
+            << " J/m\n";
+  EXPECT_GT(meter->work, 1e-4);
+  // Measured: 1.73778 against 1.73767 (6.3e-5 relative, the solid's O(dt^2) Verlet energy error).
+  EXPECT_NEAR(e1 - e0, meter->work, 1e-4 * meter->work);
+}
+
 // What the solid holds after a coupler step (its `external_force` output, a drag probe's input)
 // is the step's mean force: times the step it is the impulse the solid received over the step's
 // acoustic sub-steps, to round-off. The last sub-step's force alone, handed over before, is one
@@ -246,8 +218,8 @@ class ImpulseMeter final : public Module {
 TEST(FsiCoupler, TheSolidHoldsTheStepsMeanForceAfterEachStep) {
   const LoadedScene scene = load_scene_text(kCollision, "collision.yaml");
   std::vector<std::unique_ptr<Module>> children = collision_modules(scene);
-  auto meter_owned = std::make_unique<ImpulseMeter>(std::move(children[1]));
-  ImpulseMeter* meter = meter_owned.get();
+  auto meter_owned = std::make_unique<ForceMeter>(std::move(children[1]));
+  ForceMeter* meter = meter_owned.get();
   children[1] = std::move(meter_owned);
   auto coupler =
       make_fsi_coupler(scene.scene.couplers(0), std::move(children), {&scene.scene, "couplers[0]"});
