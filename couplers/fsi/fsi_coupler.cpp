@@ -98,6 +98,7 @@ class FsiCoupler final : public Coupler {
   double max_dt() const override { return fluid().max_dt(); }
 
   void advance(double Dt) override {
+    impulse_time_ = 0.0;  // a step that threw part-way left its impulse behind
     fluid().begin_step(Dt);
     for (double dt = fluid().max_substep(); dt > 0.0; dt = fluid().max_substep()) {
       fluid().substep(dt);

@@ -52,15 +52,16 @@ struct BoundarySet {
 
   // The fluid's force on each boundary particle, recorded pair by pair inside the fluid's own
   // loops (only for sets whose force is asked for: a coupler's contact body, walls with the
-  // `wall_force` output): the pressure force of the last acoustic sub-step, the reaction of the
-  // very Riemann pressures the fluid used in it, and the viscous force of the advection step (of
-  // the last acoustic sub-step, the mean over its split steps, where the viscous force is
-  // sub-cycled). The impulse the fluid receives is then exactly opposite to what the boundary
-  // receives. (The walls' output is these records' mean over the step, pair_impulse below.)
+  // `wall_force` or `wall_viscous_force` output): the pressure force of the last acoustic sub-step,
+  // the reaction of the very Riemann pressures the fluid used in it, and the viscous force of the
+  // advection step (of the last acoustic sub-step, the mean over its split steps, where the viscous
+  // force is sub-cycled). The impulse the fluid receives is then exactly opposite to what the
+  // boundary receives. (The walls' output is these records' mean over the step, pair_impulse
+  // below.)
   bool records = false;
   std::vector<Vec<D>> pair_pressure_force, pair_viscous_force;
   NeighbourList pairs_of;  // boundary particle -> indices of its pairs in `list`
-  // Walls with the `wall_force` output: the recorded pair forces integrated over the open
+  // Walls with a force output: the recorded pair forces integrated over the open
   // advection step's acoustic sub-steps, and the time they cover. The output is their mean, whose
   // impulse is the one the fluid received over the step. The last sub-step's force alone is one
   // phase of the step's cycle (the density is reinitialised or summed at its start), not the

@@ -478,11 +478,13 @@ TEST(Fluid, TheWallForceOutputCarriesTheImpulseTheWaterReceives) {
 // outputs. Over t = 1.5-2 the walls carry the analytic wall shear of both plates,
 // 2 x 2 x rho nu du/dy(0, t) = 2 rho g L - sum_n 16 rho g L / (pi^2 (2n+1)^2) e^(-(2n+1)^2 pi^2 nu
 // t).
-const char* kPoiseuilleForceProbes = R"yaml(
+const char* kPoiseuilleForceProbe = R"yaml(
   - name: walls_force
     body: channel_walls
     interval: 0.01
     reduce: {quantity: total, field: force}
+)yaml";
+const char* kPoiseuilleViscousForceProbe = R"yaml(
   - name: walls_viscous_force
     body: channel_walls
     interval: 0.01
@@ -499,20 +501,30 @@ double poiseuille_wall_shear(double t) {
   return f;
 }
 
-TEST(Fluid, TheWallsViscousForceOutputIsTheWallShearsShare) {
-  std::ifstream in(std::string(COSPH_SOURCE_DIR) + "/examples/fluid_poiseuille.yaml");
+// Runs the Poiseuille channel with the given fluid outputs and extra probes; returns the output
+// directory.
+std::string run_poiseuille_with(const std::string& outputs, const std::string& probes,
+                                const std::string& name) {
+  const std::string path = std::string(COSPH_SOURCE_DIR) + "/examples/fluid_poiseuille.yaml";
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << "cannot read " << path;
+  // The example's last key is `probes:`, so these join its list.
   const std::string scene =
-      std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()) +
-      kPoiseuilleForceProbes;
+      std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()) + probes;
   RunOptions options;
-  options.output_directory =
-      (std::filesystem::path(testing::TempDir()) / "cosph_fluid_viscous_share").string();
-  make_simulation(scene,
-                  {"modules[0].fluid.outputs=[wall_force, wall_viscous_force]", "output.vtp=false",
-                   "checkpoint.at_end=false"},
-                  options)
+  options.output_directory = (std::filesystem::path(testing::TempDir()) / name).string();
+  make_simulation(
+      scene, {"modules[0].fluid.outputs=" + outputs, "output.vtp=false", "checkpoint.at_end=false"},
+      options)
       ->run();
-  const std::string dir = options.output_directory;
+  return options.output_directory;
+}
+
+TEST(Fluid, TheWallsViscousForceOutputIsTheWallShearsShare) {
+  const std::string dir =
+      run_poiseuille_with("[wall_force, wall_viscous_force]",
+                          std::string(kPoiseuilleForceProbe) + kPoiseuilleViscousForceProbe,
+                          "cosph_fluid_viscous_share");
   const auto t = test::csv_column(dir + "/walls_force.csv", 0);
   const auto total = test::csv_column(dir + "/walls_force.csv", 1);
   const auto viscous = test::csv_column(dir + "/walls_viscous_force.csv", 1);
@@ -538,6 +550,11 @@ TEST(Fluid, TheWallsViscousForceOutputIsTheWallShearsShare) {
   EXPECT_LT(std::abs(total_gap), 1.5 * 0.0038);
   EXPECT_GT(viscous_gap, -1.5 * 0.042);
   EXPECT_LT(viscous_gap, -0.042 / 1.5);
+
+  // Asked for alone (its walls then record for it), the viscous output is the same.
+  const std::string alone = run_poiseuille_with(
+      "[wall_viscous_force]", kPoiseuilleViscousForceProbe, "cosph_fluid_viscous_alone");
+  EXPECT_EQ(test::csv_column(alone + "/walls_viscous_force.csv", 1), viscous);
 }
 
 // The same tank's walls read by wall sensors (the mean pressure over a face from the force on the

@@ -245,10 +245,10 @@ TEST(FsiCoupler, TheSolidHoldsTheStepsMeanForceAfterEachStep) {
   std::cout << "largest gap to the step's impulse / time: the held force " << held_gap
             << ", the last sub-step's " << last_substep_gap << " (of the largest mean component)\n";
   // Measured: 3.0e-16.
-  EXPECT_LT(held_gap, 1e-15);
+  EXPECT_LT(held_gap, 1.5 * 3.0e-16);
   // The test bites: at the impact the last sub-step's force is far from the step's mean.
   // Measured: 3.18 (the held force read this before the coupler handed over the mean).
-  EXPECT_GT(last_substep_gap, 2.0);
+  EXPECT_GT(last_substep_gap, 3.18 / 1.5);
 }
 
 // ---- Restart and threads -------------------------------------------------------------------
