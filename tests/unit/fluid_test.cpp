@@ -478,18 +478,11 @@ TEST(Fluid, TheWallForceOutputCarriesTheImpulseTheWaterReceives) {
 // outputs. Over t = 1.5-2 the walls carry the analytic wall shear of both plates,
 // 2 x 2 x rho nu du/dy(0, t) = 2 rho g L - sum_n 16 rho g L / (pi^2 (2n+1)^2) e^(-(2n+1)^2 pi^2 nu
 // t).
-const char* kPoiseuilleForceProbe = R"yaml(
-  - name: walls_force
-    body: channel_walls
-    interval: 0.01
-    reduce: {quantity: total, field: force}
-)yaml";
-const char* kPoiseuilleViscousForceProbe = R"yaml(
-  - name: walls_viscous_force
-    body: channel_walls
-    interval: 0.01
-    reduce: {quantity: total, field: viscous_force}
-)yaml";
+// A probe of the total of a wall field over the channel's walls, sampled every 0.01.
+std::string walls_total_probe(const std::string& name, const std::string& field) {
+  return "  - name: " + name + "\n    body: channel_walls\n    interval: 0.01\n" +
+         "    reduce: {quantity: total, field: " + field + "}\n";
+}
 
 double poiseuille_wall_shear(double t) {
   const double g = 0.8, nu = 0.1, L = 1.0, pi = std::acos(-1.0);
@@ -523,7 +516,8 @@ std::string run_poiseuille_with(const std::string& outputs, const std::string& p
 TEST(Fluid, TheWallsViscousForceOutputIsTheWallShearsShare) {
   const std::string dir =
       run_poiseuille_with("[wall_force, wall_viscous_force]",
-                          std::string(kPoiseuilleForceProbe) + kPoiseuilleViscousForceProbe,
+                          walls_total_probe("walls_force", "force") +
+                              walls_total_probe("walls_viscous_force", "viscous_force"),
                           "cosph_fluid_viscous_share");
   const auto t = test::csv_column(dir + "/walls_force.csv", 0);
   const auto total = test::csv_column(dir + "/walls_force.csv", 1);
@@ -553,7 +547,8 @@ TEST(Fluid, TheWallsViscousForceOutputIsTheWallShearsShare) {
 
   // Asked for alone (its walls then record for it), the viscous output is the same.
   const std::string alone = run_poiseuille_with(
-      "[wall_viscous_force]", kPoiseuilleViscousForceProbe, "cosph_fluid_viscous_alone");
+      "[wall_viscous_force]", walls_total_probe("walls_viscous_force", "viscous_force"),
+      "cosph_fluid_viscous_alone");
   EXPECT_EQ(test::csv_column(alone + "/walls_viscous_force.csv", 1), viscous);
 }
 

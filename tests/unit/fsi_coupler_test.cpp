@@ -189,15 +189,26 @@ double solid_energy(Module& solid) {
   return e;
 }
 
-TEST(FsiCoupler, WorkOfTheFluidForceIsTheSolidsEnergyChange) {
+// The collision scene's FSI coupler with a ForceMeter between it and the solid, initialised.
+struct MeteredCollision {
+  MeteredCollision() {
+    std::vector<std::unique_ptr<Module>> children = collision_modules(scene);
+    auto owned = std::make_unique<ForceMeter>(std::move(children[1]));
+    meter = owned.get();
+    children[1] = std::move(owned);
+    coupler = make_fsi_coupler(scene.scene.couplers(0), std::move(children),
+                               {&scene.scene, "couplers[0]"});
+    coupler->initialize();
+  }
   const LoadedScene scene = load_scene_text(kCollision, "collision.yaml");
-  std::vector<std::unique_ptr<Module>> children = collision_modules(scene);
-  auto meter_owned = std::make_unique<ForceMeter>(std::move(children[1]));
-  ForceMeter* meter = meter_owned.get();
-  children[1] = std::move(meter_owned);
-  auto coupler =
-      make_fsi_coupler(scene.scene.couplers(0), std::move(children), {&scene.scene, "couplers[0]"});
-  coupler->initialize();
+  ForceMeter* meter = nullptr;
+  std::unique_ptr<Coupler> coupler;
+};
+
+TEST(FsiCoupler, WorkOfTheFluidForceIsTheSolidsEnergyChange) {
+  MeteredCollision run;
+  ForceMeter* meter = run.meter;
+  Coupler* coupler = run.coupler.get();
   // Up to the impact, then over the steps in which the water pushes the block.
   while (meter->work == 0.0) coupler->advance(coupler->max_dt());
   const double e0 = solid_energy(*meter);
@@ -216,14 +227,9 @@ TEST(FsiCoupler, WorkOfTheFluidForceIsTheSolidsEnergyChange) {
 // acoustic sub-steps, to round-off. The last sub-step's force alone, handed over before, is one
 // phase of the fluid's cycle within the step.
 TEST(FsiCoupler, TheSolidHoldsTheStepsMeanForceAfterEachStep) {
-  const LoadedScene scene = load_scene_text(kCollision, "collision.yaml");
-  std::vector<std::unique_ptr<Module>> children = collision_modules(scene);
-  auto meter_owned = std::make_unique<ForceMeter>(std::move(children[1]));
-  ForceMeter* meter = meter_owned.get();
-  children[1] = std::move(meter_owned);
-  auto coupler =
-      make_fsi_coupler(scene.scene.couplers(0), std::move(children), {&scene.scene, "couplers[0]"});
-  coupler->initialize();
+  MeteredCollision run;
+  ForceMeter* meter = run.meter;
+  Coupler* coupler = run.coupler.get();
   // The largest gaps over the run, and the largest mean force component (their scale).
   double held_gap = 0.0, last_substep_gap = 0.0, scale = 0.0;
   for (int step = 0; step < 60; ++step) {
