@@ -98,7 +98,7 @@ class FsiCoupler final : public Coupler {
   double max_dt() const override { return fluid().max_dt(); }
 
   void advance(double Dt) override {
-    impulse_time_ = 0.0;  // a step that threw part-way left its impulse behind
+    impulse_time_ = 0.0;  // the last step's impulse (or a step's that threw part-way) emptied
     fluid().begin_step(Dt);
     for (double dt = fluid().max_substep(); dt > 0.0; dt = fluid().max_substep()) {
       fluid().substep(dt);
@@ -211,13 +211,12 @@ class FsiCoupler final : public Coupler {
     impulse_time_ += dt;
   }
 
-  // The step's mean force to the solid, and the impulse emptied for the next step.
+  // The step's mean force to the solid (advance empties the impulse at the next step's start).
   void hand_mean_force() {
     if (!(impulse_time_ > 0.0)) return;
     auto& f = force_.arrays.at("force").values;
     for (std::size_t c = 0; c < f.size(); ++c) f[c] = impulse_[c] / impulse_time_;
     solid().read(external_force_port_, force_);
-    impulse_time_ = 0.0;
   }
 
   void send_contact() {

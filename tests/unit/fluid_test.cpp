@@ -473,17 +473,17 @@ TEST(Fluid, TheWallForceOutputCarriesTheImpulseTheWaterReceives) {
   EXPECT_NEAR(balance, 1.0, 1.5 * 3.4e-4);      // measured 0.99966
 }
 
-// Transient Poiseuille flow (examples/fluid_poiseuille.yaml, periodic along x, body force g = 0.8,
-// nu = 0.1, plates at y = 0 and 1, 2 long) with the walls' force and its viscous share as
-// outputs. Over t = 1.5-2 the walls carry the analytic wall shear of both plates,
-// 2 x 2 x rho nu du/dy(0, t) = 2 rho g L - sum_n 16 rho g L / (pi^2 (2n+1)^2) e^(-(2n+1)^2 pi^2 nu
-// t).
 // A probe of the total of a wall field over the channel's walls, sampled every 0.01.
 std::string walls_total_probe(const std::string& name, const std::string& field) {
   return "  - name: " + name + "\n    body: channel_walls\n    interval: 0.01\n" +
          "    reduce: {quantity: total, field: " + field + "}\n";
 }
 
+// Transient Poiseuille flow (examples/fluid_poiseuille.yaml, periodic along x, body force g = 0.8,
+// nu = 0.1, plates at y = 0 and 1, 2 long) with the walls' force and its viscous share as
+// outputs. Over t = 1.5-2 the walls carry the analytic wall shear of both plates,
+// 2 x 2 x rho nu du/dy(0, t) = 2 rho g L - sum_n 16 rho g L / (pi^2 (2n+1)^2) e^(-(2n+1)^2 pi^2 nu
+// t).
 double poiseuille_wall_shear(double t) {
   const double g = 0.8, nu = 0.1, L = 1.0, pi = std::acos(-1.0);
   double f = 2.0 * g * L;
