@@ -48,6 +48,10 @@ class FluidModule final : public Module {
       throw ConfigError(key_ + ".transport_velocity_hydrostatic_band",
                         "a hydrostatic band needs gravity: without it no pressure marks the layer "
                         "under the free surface");
+    if (has_output("wall_viscous_force") && !(spec_.viscosity() > 0.0))
+      throw ConfigError(key_ + ".outputs",
+                        "'wall_viscous_force' needs a viscous fluid: with viscosity 0 there is no "
+                        "viscous term to split from wall_force");
     for (int a = 0; a < spec_.initial_velocity_size(); ++a)
       initial_velocity_.push_back(
           parse(spec_.initial_velocity(a), key_ + ".initial_velocity[" + std::to_string(a) + "]"));

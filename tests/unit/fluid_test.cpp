@@ -899,6 +899,10 @@ TEST(Fluid, BadInputNamesTheKey) {
   EXPECT_NE(vertex.find("equal particle volumes"), std::string::npos) << vertex;
   EXPECT_NE(message({"modules[0].fluid.body.placement=nodes"}).find("placement"),
             std::string::npos);
+  // The tank's water is inviscid: it has no viscous share of the walls' force to write.
+  const std::string inviscid = message({"modules[0].fluid.outputs=[wall_viscous_force]"});
+  EXPECT_NE(inviscid.find("modules[0].fluid.outputs"), std::string::npos) << inviscid;
+  EXPECT_NE(inviscid.find("viscous fluid"), std::string::npos) << inviscid;
   const std::string within = [&] {
     std::vector<std::string> set = kWallForceOutput;
     set.insert(set.end(), {"probes[3].reduce.quantity=maximum", "probes[3].reduce.field=volume"});
