@@ -670,7 +670,7 @@ class FluidModule final : public Module {
           b->pair_viscous_force.assign(b->list.pair_count(), Vec<D>::Zero());
         if (b == &walls_) {  // the output's step mean (a contact body is handed each sub-step's)
           b->pair_impulse.assign(b->list.pair_count(), Vec<D>::Zero());
-          if (spec_.viscosity() > 0.0 && b->particles.has("viscous_force"))
+          if (b->particles.has("viscous_force"))  // only a viscous fluid has it (the constructor)
             b->pair_viscous_impulse.assign(b->list.pair_count(), Vec<D>::Zero());
           b->impulse_time = 0.0;
         }
